@@ -1,0 +1,27 @@
+// Asset discovery with the original loader's directory rules (spec 2.4):
+// which files a background folder or a skin folder contributes, in what order.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kage {
+
+/// Background images of `dir` (spec 2.4 background step 2): files directly in
+/// `dir` matching `*.jpg`, `*.jpeg`, `*.png`, `*.bmp` (case-sensitive), the
+/// union sorted by path string ("bg-1", "bg-10", "bg-100", ...). Returns
+/// nullopt when `dir` is not an existing directory; an empty list when it has
+/// no matching file. Paths are `dir + "/" + name`.
+std::optional<std::vector<std::string>> scan_background_dir(const std::string& dir);
+
+/// Skin (or NPC type) directories under `dir` (spec 2.4 skins step 1): the
+/// immediate subdirectories, sorted by path string. nullopt when `dir` is not
+/// an existing directory (the original then warns and loads no sprites).
+std::optional<std::vector<std::string>> scan_skin_parent(const std::string& dir);
+
+/// Frame files of one skin (spec 2.4 skins step 4): every `*.png` under `dir`,
+/// recursively, sorted by path string. Empty when `dir` is missing.
+std::vector<std::string> scan_skin_frames(const std::string& dir);
+
+}  // namespace kage
