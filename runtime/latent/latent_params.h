@@ -57,7 +57,7 @@ static_assert(sizeof(LatentParams) == 35 * 4, "LatentParams layout changed: upda
 
 /// The two event thresholds of spec 4.3 step 2: computed in double from the config's double values,
 /// then rounded to float32 for the comparison with the float32 uniforms (e.g. 0.3 and 0.65 for 0.7 / 0.5).
-inline void layout_thresholds(double p_change, double p_up_given_change, float& t_flat, float& t_up) {
+KAGE_HD void layout_thresholds(double p_change, double p_up_given_change, float& t_flat, float& t_up) {
   const double flat = 1.0 - p_change;
   t_flat = static_cast<float>(flat);
   t_up = static_cast<float>(flat + p_change * p_up_given_change);

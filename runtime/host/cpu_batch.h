@@ -1,0 +1,103 @@
+// CPU batch runtime: N environments stepped with the KAGE_HD latent semantics, split over threads.
+// Observations come from a render hook; without one the batch runs the hidden game only.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "runtime/latent/latent_params.h"
+#include "runtime/latent/latent_state.h"
+#include "runtime/latent/layout.h"
+#include "runtime/rng.h"
+
+namespace kage {
+
+/// Fills one environment's observation (H x W x 3 uint8, row-major) from its latent state. Called from
+/// worker threads, at most once per environment per reset/step and never twice at once for the same env.
+struct RenderHook {
+  void* user = nullptr;
+  /// After a reset (explicit or automatic) of `env`: the new episode's key, state (t = 0) and layout.
+  void (*on_reset)(void* user, int32_t env, Key episode_key, const LatentParams& p, LayoutView layout,
+                   const LatentState& s, uint8_t* obs) = nullptr;
+  /// After a step that did not end in an automatic reset, on the post-step state.
+  void (*on_step)(void* user, int32_t env, Key episode_key, const LatentParams& p, LayoutView layout,
+                  const LatentState& s, uint8_t* obs) = nullptr;
+};
+
+struct CpuBatchOptions {
+  int32_t num_threads = 1;  ///< worker count (>= 1); results do not depend on it
+  bool autoreset = true;    ///< reset a finished episode at once with the next episode key
+};
+
+/// Per-environment results of the last reset or step (structure of arrays, N entries each). After an
+/// automatic reset they describe the finished episode's last step (the info of spec 5.8).
+struct BatchInfo {
+  std::vector<float> reward;
+  std::vector<uint8_t> terminated;
+  std::vector<uint8_t> truncated;
+  std::vector<float> x;
+  std::vector<float> y;
+  std::vector<float> vx;
+  std::vector<float> vy;
+  std::vector<float> passed_distance;
+  std::vector<float> progress;
+  std::vector<uint8_t> success;
+  std::vector<uint8_t> success_once;
+  std::vector<float> episode_return;  ///< info "return"
+  std::vector<int32_t> jump_count;
+  std::vector<int32_t> timestep;      ///< info "timestep" = t
+};
+
+/// N environments of one latent configuration. Episode e of the environment given seed s uses the key
+/// fold(seed_key(s), e); reset(seeds) starts episode 0.
+class CpuBatch {
+ public:
+  /// A batch of `num_envs` environments, or nothing if the parameters are unsupported
+  /// (latent_params_supported) or num_envs / num_threads are not positive.
+  [[nodiscard]] static std::optional<CpuBatch> create(const LatentParams& p, int32_t num_envs,
+                                                      const CpuBatchOptions& options);
+
+  /// Installs the observation hook; the observation buffer stays zero without one.
+  void set_render_hook(const RenderHook& hook) { hook_ = hook; }
+
+  /// Starts episode 0 of every environment; `seeds` has size() entries.
+  void reset(const uint64_t* seeds);
+
+  /// Advances every environment by one action (size() entries, any int32: spec 3.2 masks them).
+  void step(const int32_t* actions);
+
+  int32_t size() const { return num_envs_; }
+  const LatentParams& params() const { return params_; }
+  const BatchInfo& info() const { return info_; }
+  /// Observations [N][H][W][3] of the last reset or step (the new episode's after an automatic reset).
+  const uint8_t* observations() const { return obs_.data(); }
+  const LatentState& state(int32_t env) const { return states_[env]; }
+  LayoutView layout(int32_t env) const { return LayoutView{segments_.data() + static_cast<size_t>(env) * stride_}; }
+  /// The key of the episode environment `env` is in now.
+  Key episode_key(int32_t env) const;
+
+ private:
+  CpuBatch(const LatentParams& p, int32_t num_envs, const CpuBatchOptions& options);
+
+  /// Runs fn(first, last) over a static partition of the environments, one range per thread.
+  template <class Fn>
+  void parallel_for(const Fn& fn);
+  void reset_env(int32_t env, uint32_t episode);
+  void record_info(int32_t env, const StepOutcome& o);
+  uint8_t* obs(int32_t env) { return obs_.data() + static_cast<size_t>(env) * obs_stride_; }
+
+  LatentParams params_;
+  int32_t num_envs_;
+  CpuBatchOptions options_;
+  size_t stride_;      ///< layout bytes per environment
+  size_t obs_stride_;  ///< H * W * 3
+  RenderHook hook_;
+  std::vector<uint64_t> seeds_;
+  std::vector<LatentState> states_;
+  std::vector<uint8_t> segments_;
+  std::vector<uint8_t> obs_;
+  BatchInfo info_;
+};
+
+}  // namespace kage
