@@ -26,14 +26,16 @@ KAGE_HD int32_t ground_top(const LatentParams& p, LayoutView v, int32_t c) {
   return p.base_ground_y - p.pix_per_unit * segment_height(p, v, cc / p.run_width);
 }
 
-/// Rows [lo, hi) of column c that are solid. The band [gt, gt + thickness) and the connector
-/// [min(gt[c-1], gt), max(gt[c-1], gt)) of spec 4.3 step 6 always touch, so their union is the single
-/// interval [min(gt[c-1], gt), max(gt[c-1], gt + thickness)); column 0 has no left neighbour, and
-/// using gt[0] for it gives the band alone. c must lie in [0, L).
+/// Solid rows [lo, hi) of one column.
 struct SolidSpan {
   int32_t lo;
   int32_t hi;
 };
+
+/// The solid rows of column c in [0, L). The band [gt, gt + thickness) and the connector
+/// [min(gt[c-1], gt), max(gt[c-1], gt)) of spec 4.3 step 6 always touch, so their union is the single
+/// interval [min(gt[c-1], gt), max(gt[c-1], gt + thickness)); column 0 has no left neighbour, and
+/// using gt[0] for it gives the band alone.
 
 KAGE_HD SolidSpan solid_span(const LatentParams& p, LayoutView v, int32_t c) {
   const int32_t gt = ground_top(p, v, c);

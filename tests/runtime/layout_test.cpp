@@ -2,7 +2,9 @@
 // the spec's stated ranges and distributions and against a direct transcription of the mask definition.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <vector>
 
 #include "runtime/latent/layout.h"

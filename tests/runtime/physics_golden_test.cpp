@@ -2,6 +2,7 @@
 // replayed on their recorded layouts, plus the worked examples of spec Appendix B.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
