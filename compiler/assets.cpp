@@ -1,0 +1,211 @@
+// Asset location, existence and hashing for the asset groups of key_refs.h.
+#include "compiler/assets.h"
+
+#include <stb/stb_image.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "compiler/key_refs.h"
+#include "runtime/host/asset_scan.h"
+#include "runtime/host/sha256.h"
+
+namespace kage {
+
+namespace fs = std::filesystem;
+
+std::string display_path(const std::string& path) {
+  fs::path p = fs::path(path).lexically_normal();
+  if (p.is_absolute()) {
+    std::error_code ec;
+    const fs::path rel = p.lexically_relative(fs::current_path(ec));
+    if (!ec && !rel.empty()) p = rel;
+  }
+  std::string s = p.generic_string();
+  if (s.size() > 1 && s.back() == '/') s.pop_back();
+  return s;
+}
+
+namespace {
+
+class AssetResolver {
+ public:
+  AssetResolver(const ComposedConfig& config, const Schema& schema, const ResolveOptions& options,
+                const SourceManager& sources, Spec& spec, DiagEngine& diags)
+      : config_(config), schema_(schema), options_(options), sources_(sources), spec_(spec), diags_(diags) {}
+
+  void run() {
+    rewrite_paths();
+    for (const AssetGroupRef& group : kAssetGroups) {
+      const Json& enable = spec_.value(group.enable_key);
+      const bool on = enable.is_boolean() ? (enable.get<bool>() && std::string(group.enable_value) == "true")
+                                          : enable == Json(group.enable_value);
+      if (!on) continue;
+      if (group.images)
+        resolve_backgrounds(group);
+      else
+        resolve_skins(group);
+    }
+  }
+
+ private:
+  // Each asset key's value becomes a working-directory-relative path.
+  void rewrite_paths() {
+    for (const KeySchema& k : schema_.keys()) {
+      if (k.asset_kind.empty()) continue;
+      const DocEntry* entry = find_key_entry(config_.root, k);
+      if (!entry) continue;
+      Json& v = k.section.empty() ? spec_.values[k.name] : spec_.values[k.section][k.name];
+      const std::string base = base_dir(entry->value);
+      if (v.is_string()) v = display_path(join_path(base, v.get<std::string>()));
+      if (v.is_array())
+        for (Json& item : v)
+          if (item.is_string()) item = display_path(join_path(base, item.get<std::string>()));
+    }
+  }
+
+  std::string base_dir(const DocNode& node) const {
+    if (options_.asset_root) return *options_.asset_root;
+    if (!node.range.begin.valid()) return "";
+    return parent_dir(sources_.name(node.range.begin.file));
+  }
+
+  const DocNode* node_of(const char* path) const {
+    const KeySchema* k = schema_.find(path);
+    return k ? find_key(config_.root, *k) : nullptr;
+  }
+
+  Range range_of(const char* path) const {
+    const DocEntry* e = nullptr;
+    if (const KeySchema* k = schema_.find(path)) e = find_key_entry(config_.root, *k);
+    return e ? e->value.range : Range{};
+  }
+
+  // The range of list item i of a key, or the key's range.
+  Range item_range(const char* path, size_t i) const {
+    const DocNode* n = node_of(path);
+    if (n && n->is_seq() && i < n->items.size()) return n->items[i].range;
+    return range_of(path);
+  }
+
+  std::optional<AssetFile> hash_image(const std::string& file, Range at, const std::string& key) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) {
+      diags_.report(Rule::AssetMissing, at, "asset file '" + file + "' (from '" + key + "') does not exist; fix the path",
+                    "/" + key);
+      return std::nullopt;
+    }
+    std::ostringstream buf;
+    buf << in.rdbuf();
+    const std::string bytes = buf.str();
+    int w = 0, h = 0, c = 0;
+    if (!stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), static_cast<int>(bytes.size()), &w, &h,
+                               &c) ||
+        w <= 0 || h <= 0) {
+      diags_.report(Rule::AssetUnreadable, at,
+                    "asset file '" + file + "' is not a readable PNG, JPEG or BMP image (" +
+                        (stbi_failure_reason() ? stbi_failure_reason() : "unknown format") + "); replace it",
+                    "/" + key);
+      return std::nullopt;
+    }
+    return AssetFile{display_path(file), sha256_hex(bytes), w, h};
+  }
+
+  void resolve_backgrounds(const AssetGroupRef& g) {
+    const char* paths_key = g.sources[0];
+    const char* dir_key = g.sources[1];
+    const char* file_key = g.sources[2];
+    std::vector<std::pair<std::string, Range>> files;
+    const Json& list = spec_.value(paths_key);
+    if (list.is_array() && !list.empty()) {
+      for (size_t i = 0; i < list.size(); ++i) files.emplace_back(list[i].get<std::string>(), item_range(paths_key, i));
+    } else if (const Json& dir = spec_.value(dir_key); dir.is_string()) {
+      const auto found = scan_background_dir(dir.get<std::string>());
+      if (!found) {
+        diags_.report(Rule::AssetMissing, range_of(dir_key),
+                      "background folder '" + dir.get<std::string>() + "' does not exist; fix the path",
+                      "/" + std::string(dir_key));
+        return;
+      }
+      for (const std::string& f : *found) files.emplace_back(f, range_of(dir_key));
+    }
+    if (files.empty()) {
+      if (const Json& one = spec_.value(file_key); one.is_string()) files.emplace_back(one.get<std::string>(), range_of(file_key));
+    }
+    if (files.empty()) {
+      const Range at = range_of(g.enable_key);
+      diags_.report(Rule::AssetEmpty, at,
+                    "background mode is 'image' but no background images were found; set one of " +
+                        std::string(paths_key) + ", " + dir_key + " or " + file_key,
+                    "/" + std::string(g.enable_key));
+      return;
+    }
+    for (const auto& [file, at] : files)
+      if (auto f = hash_image(file, at, std::string(paths_key))) spec_.assets.backgrounds.push_back(*f);
+  }
+
+  void resolve_skins(const AssetGroupRef& g) {
+    std::vector<std::pair<std::string, Range>> dirs;
+    const Json& parent = spec_.value(g.sources[0]);
+    const Json& list = spec_.value(g.sources[1]);
+    const Json& single = spec_.value(g.sources[2]);
+    if (parent.is_string()) {
+      const auto found = scan_skin_parent(parent.get<std::string>());
+      if (!found) {
+        diags_.report(Rule::AssetMissing, range_of(g.sources[0]),
+                      "sprite folder '" + parent.get<std::string>() +
+                          "' does not exist (the original would load no sprites and draw nothing); fix the path",
+                      "/" + std::string(g.sources[0]));
+        return;
+      }
+      for (const std::string& d : *found) dirs.emplace_back(d, range_of(g.sources[0]));
+    } else if (list.is_array() && !list.empty()) {
+      for (size_t i = 0; i < list.size(); ++i) dirs.emplace_back(list[i].get<std::string>(), item_range(g.sources[1], i));
+    } else if (single.is_string()) {
+      dirs.emplace_back(single.get<std::string>(), range_of(g.sources[2]));
+    }
+    if (dirs.empty()) {
+      diags_.report(Rule::AssetNoSprites, range_of(g.enable_key),
+                    "'" + std::string(g.enable_key) + "' is true but no sprites are given, so nothing is drawn; set " +
+                        g.sources[0] + ", " + g.sources[1] + " or " + g.sources[2],
+                    "/" + std::string(g.enable_key));
+      return;
+    }
+    std::vector<AssetSet>& sets = *spec_.assets.sets(g.name);
+    for (const auto& [dir, at] : dirs) {
+      std::error_code ec;
+      if (!fs::is_directory(dir, ec)) {
+        diags_.report(Rule::AssetMissing, at, "sprite folder '" + dir + "' does not exist; fix the path",
+                      "/" + std::string(g.sources[1]));
+        continue;
+      }
+      AssetSet set;
+      set.dir = display_path(dir);
+      for (const std::string& frame : scan_skin_frames(dir))
+        if (auto f = hash_image(frame, at, g.sources[1])) set.frames.push_back(*f);
+      if (set.frames.empty()) {
+        diags_.report(Rule::AssetEmpty, at, "sprite folder '" + dir + "' holds no PNG frames; add frames or remove it",
+                      "/" + std::string(g.sources[1]));
+        continue;
+      }
+      sets.push_back(std::move(set));
+    }
+  }
+
+  const ComposedConfig& config_;
+  const Schema& schema_;
+  const ResolveOptions& options_;
+  const SourceManager& sources_;
+  Spec& spec_;
+  DiagEngine& diags_;
+};
+
+}  // namespace
+
+void resolve_assets(const ComposedConfig& config, const Schema& schema, const ResolveOptions& options,
+                    const SourceManager& sources, Spec& spec, DiagEngine& diags) {
+  AssetResolver(config, schema, options, sources, spec, diags).run();
+}
+
+}  // namespace kage

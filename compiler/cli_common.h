@@ -1,0 +1,32 @@
+// Options shared by the commands that read configs (CLI11 glue).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "compiler/commands.h"
+#include "compiler/diag.h"
+#include "compiler/resolve.h"
+
+namespace kage {
+
+struct DiagOptions {
+  std::string format = "text";
+  bool werror = false;
+  std::vector<std::string> disabled;
+  std::string asset_root;
+
+  void add_to(CLI::App& app, bool with_format = true);
+  /// Applies --Werror/--disable; reports unknown rule ids to io.err. False on a usage error.
+  bool apply(DiagEngine& diags, CommandIo& io) const;
+  ResolveOptions resolve_options() const;
+};
+
+/// Parses `args` into `app`; on --help or a usage error prints and returns the exit code.
+std::optional<int> parse_args(CLI::App& app, const std::vector<std::string>& args, CommandIo& io);
+
+/// Prints diagnostics in the chosen format.
+void emit_diagnostics(const DiagEngine& diags, const DiagOptions& opts, CommandIo& io);
+
+}  // namespace kage
