@@ -1,0 +1,6 @@
+#!/usr/bin/env bash
+# Builds (installing what is missing) and runs the whole test suite through CTest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/build.sh
+ctest --test-dir build --output-on-failure -j"$(nproc)"
