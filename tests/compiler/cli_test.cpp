@@ -1,0 +1,167 @@
+// The kagec command line through run_kagec with string streams: exit codes
+// 0/1/2, did-you-mean for commands, the frozen JSON diagnostic format.
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include "compiler/commands.h"
+#include "test_support.h"
+
+namespace kage::test {
+namespace {
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+CliRun kagec(const std::vector<std::string>& args) {
+  fs::current_path(source_dir());  // paths in output are relative to the working directory
+  std::ostringstream out, err;
+  CommandIo io{out, err, false};
+  CliRun r;
+  r.code = run_kagec(args, io);
+  r.out = out.str();
+  r.err = err.str();
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("kagec without arguments is a usage error", "[cli]") {
+  const CliRun r = kagec({});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("usage: kagec <command>") != std::string::npos);
+  CHECK(r.out.empty());
+}
+
+TEST_CASE("an unknown command suggests the closest one", "[cli]") {
+  const CliRun r = kagec({"lnit", "x.yaml"});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("kagec: unknown command 'lnit'; did you mean 'lint'?") != std::string::npos);
+  const CliRun far = kagec({"compile"});
+  CHECK(far.code == 2);
+  CHECK(far.err.find("unknown command 'compile'") != std::string::npos);
+  CHECK(far.err.find("did you mean") == std::string::npos);
+}
+
+TEST_CASE("--disable with an unknown rule is a usage error", "[cli]") {
+  const CliRun r = kagec({"lint", "--disable", "inert-settings", "tests/lint/no-diagnostics.yaml"});
+  CHECK(r.code == 2);
+  CHECK(r.err.find("unknown rule 'inert-settings' for --disable") != std::string::npos);
+}
+
+TEST_CASE("lint exit codes: clean 0, warnings 0, errors 1, --Werror turns warnings into errors", "[cli]") {
+  CHECK(kagec({"lint", "tests/lint/no-diagnostics.yaml"}).code == 0);
+  const CliRun warn = kagec({"lint", "tests/lint/range-recommended.yaml"});
+  CHECK(warn.code == 0);
+  CHECK(warn.err.find("0 errors, 2 warnings") != std::string::npos);
+  const CliRun werror = kagec({"lint", "--Werror", "tests/lint/range-recommended.yaml"});
+  CHECK(werror.code == 1);
+  CHECK(werror.err.find("2 errors, 0 warnings") != std::string::npos);
+  const CliRun disabled = kagec({"lint", "--Werror", "--disable", "range-recommended", "tests/lint/range-recommended.yaml"});
+  CHECK(disabled.code == 0);
+  const CliRun err = kagec({"lint", "tests/lint/schema-type.yaml"});
+  CHECK(err.code == 1);
+  CHECK(err.err.find("tests/lint/schema-type.yaml:4:12: error: 'physics.gravity' must be a number") != std::string::npos);
+  CHECK(kagec({"lint"}).code == 2);                       // the file argument is required
+  CHECK(kagec({"lint", "--format", "xml", "a.yaml"}).code == 2);  // not a format
+}
+
+TEST_CASE("kagec lint of a missing file reports file-unreadable", "[cli]") {
+  const CliRun r = kagec({"lint", "tests/lint/there_is_no_such_file.yaml"});
+  CHECK(r.code == 1);
+  CHECK(r.err.find("cannot read 'tests/lint/there_is_no_such_file.yaml'") != std::string::npos);
+  CHECK(r.err.find("[file-unreadable]") != std::string::npos);
+}
+
+TEST_CASE("text diagnostics show the source line, a caret, fix-its and notes", "[cli]") {
+  const CliRun r = kagec({"lint", "tests/lint/schema-unknown-key-json.yaml"});
+  CHECK(r.code == 1);
+  const std::string expected =
+      "tests/lint/schema-unknown-key-json.yaml:3:3: error: unknown key 'gravty' in 'physics'; did you mean "
+      "'gravity'? [schema-unknown-key]\n"
+      "  gravty: 0.5\n"
+      "  ^~~~~\n"
+      "fix-it: replace with 'gravity'\n"
+      "tests/lint/schema-unknown-key-json.yaml:8:16: error: 'character.use_shape' and 'character.use_sprites' are "
+      "both given, so exactly one of them must be true; set one to false [schema-shape-or-sprites]\n"
+      "  use_sprites: true\n"
+      "               ^~~~\n"
+      "tests/lint/schema-unknown-key-json.yaml:6:14: note: 'use_shape' is given here\n"
+      "2 errors, 0 warnings\n";
+  CHECK(r.err == expected);
+}
+
+TEST_CASE("--format json prints the frozen diagnostic format", "[cli][json]") {
+  const CliRun r = kagec({"lint", "--format", "json", "tests/lint/schema-unknown-key-json.yaml"});
+  CHECK(r.code == 1);
+  CHECK(r.err.empty());
+  const std::string file = "tests/lint/schema-unknown-key-json.yaml";
+  const nlohmann::json expected = nlohmann::json::parse(R"({
+    "version": 1,
+    "diagnostics": [
+      {"file": "tests/lint/schema-unknown-key-json.yaml", "line": 3, "col": 3, "end_line": 3, "end_col": 9,
+       "offset": 115, "severity": "error", "rule": "schema-unknown-key",
+       "message": "unknown key 'gravty' in 'physics'; did you mean 'gravity'?", "path": "/physics/gravty",
+       "notes": [],
+       "fixits": [{"line": 3, "col": 3, "offset": 115, "length": 6, "replacement": "gravity"}]},
+      {"file": "tests/lint/schema-unknown-key-json.yaml", "line": 8, "col": 16, "end_line": 8, "end_col": 20,
+       "offset": 309, "severity": "error", "rule": "schema-shape-or-sprites",
+       "message": "'character.use_shape' and 'character.use_sprites' are both given, so exactly one of them must be true; set one to false",
+       "path": "/character/use_sprites",
+       "notes": [{"message": "'use_shape' is given here", "file": "tests/lint/schema-unknown-key-json.yaml", "line": 6, "col": 14}],
+       "fixits": []}
+    ],
+    "summary": {"errors": 2, "warnings": 0}
+  })");
+  const nlohmann::json actual = nlohmann::json::parse(r.out);
+  CHECK(actual == expected);
+  // Field order is part of the frozen format.
+  const nlohmann::ordered_json ordered = nlohmann::ordered_json::parse(r.out);
+  std::vector<std::string> top, fields;
+  for (auto& [k, v] : ordered.items()) top.push_back(k);
+  for (auto& [k, v] : ordered.at("diagnostics").at(0).items()) fields.push_back(k);
+  CHECK(top == std::vector<std::string>{"version", "diagnostics", "summary"});
+  CHECK(fields == std::vector<std::string>{"file", "line", "col", "end_line", "end_col", "offset", "severity", "rule",
+                                           "message", "path", "notes", "fixits"});
+  (void)file;
+}
+
+TEST_CASE("diff --certify: usage errors, certified and failing pairs", "[cli][diff]") {
+  const std::string train = "configs/kage_bench/bases/shape_black.yaml";
+  const std::string eval = "configs/kage_bench/background/1-eval.yaml";
+  CHECK(kagec({"diff", "--certify", "colour", train, eval}).code == 2);
+  CHECK(kagec({"diff", "--certify", "latent", train, eval}).code == 2);
+  const CliRun ok = kagec({"diff", train, eval, "--certify", "background"});
+  CHECK(ok.code == 0);
+  CHECK(ok.out.find("certified: exactly one visual axis changes (background), nothing latent") != std::string::npos);
+  const CliRun wrong = kagec({"diff", train, eval, "--certify", "filters"});
+  CHECK(wrong.code == 1);
+  CHECK(wrong.out.find("not certified: declared axis 'filters' does not change") != std::string::npos);
+  const CliRun same = kagec({"diff", train, train, "--certify"});
+  CHECK(same.code == 1);
+  CHECK(same.out.find("no effective differences") != std::string::npos);
+  CHECK(same.out.find("degenerate pair") != std::string::npos);
+  CHECK(kagec({"diff", train, eval}).code == 0);  // without --certify a diff is information only
+}
+
+TEST_CASE("resolve prints the canonical Spec, or nothing when there are errors", "[cli][resolve]") {
+  const CliRun ok = kagec({"resolve", "tests/lint/no-diagnostics.yaml"});
+  CHECK(ok.code == 0);
+  const nlohmann::json spec = nlohmann::json::parse(ok.out);
+  CHECK(spec.at("kagec_spec") == 1);
+  CHECK(spec.at("config").at("W") == 8);
+  CHECK(spec.at("sha256").get<std::string>().size() == 64);
+  const CliRun bad = kagec({"resolve", "tests/lint/schema-type.yaml"});
+  CHECK(bad.code == 1);
+  CHECK(bad.out.empty());
+  CHECK(bad.err.find("no Spec") != std::string::npos);
+}
+
+TEST_CASE("rules lists every rule once", "[cli]") {
+  const CliRun r = kagec({"rules"});
+  CHECK(r.code == 0);
+  for (const RuleInfo& rule : all_rules()) CHECK(r.out.find(std::string(rule.id) + " ") != std::string::npos);
+}
+
+}  // namespace kage::test
