@@ -15,6 +15,9 @@ const std::vector<Command>& commands() {
       {"suite", "lint and certify every pair of a suite manifest", cmd_suite},
       {"rules", "list every diagnostic rule with its severity", cmd_rules},
       {"schema", "print the configuration JSON Schema (for editors)", cmd_schema},
+      {"render", "run one environment and write its frames as PNG, GIF or a contact sheet", cmd_render},
+      {"bench", "measure environment steps per second (--cpu)", cmd_bench},
+      {"golden", "check the runtime against the reference data of the original (golden check)", cmd_golden},
   };
   return table;
 }

@@ -39,5 +39,8 @@ int cmd_diff(const std::vector<std::string>& args, CommandIo& io);
 int cmd_suite(const std::vector<std::string>& args, CommandIo& io);
 int cmd_rules(const std::vector<std::string>& args, CommandIo& io);
 int cmd_schema(const std::vector<std::string>& args, CommandIo& io);
+int cmd_render(const std::vector<std::string>& args, CommandIo& io);
+int cmd_bench(const std::vector<std::string>& args, CommandIo& io);
+int cmd_golden(const std::vector<std::string>& args, CommandIo& io);
 
 }  // namespace kage

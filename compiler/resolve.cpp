@@ -7,6 +7,7 @@
 #include "compiler/check.h"
 #include "compiler/conditions.h"
 #include "compiler/lints.h"
+#include "compiler/lower.h"
 
 namespace kage {
 
@@ -101,6 +102,7 @@ Spec resolve_config(const ComposedConfig& config, const Schema& schema, const Re
     if (k.alias_of.empty() && inert_reason(k, spec)) spec.inert.insert(k.path);
   resolve_assets(config, schema, options, sources, spec, diags);
   run_context_lints(config, schema, spec, diags);
+  report_capacity(config, spec, diags);
   return spec;
 }
 

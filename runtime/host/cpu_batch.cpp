@@ -90,6 +90,7 @@ void CpuBatch::step(const int32_t* actions) {
       const StepOutcome o = latent_step(params_, layout, states_[env], actions[env]);
       record_info(env, o);
       if (options_.autoreset && (o.terminated || o.truncated)) {
+        if (hook_.on_final) hook_.on_final(hook_.user, env, episode_key(env), params_, layout, states_[env]);
         reset_env(env, states_[env].episode + 1);
       } else if (hook_.on_step) {
         hook_.on_step(hook_.user, env, episode_key(env), params_, layout, states_[env], obs(env));

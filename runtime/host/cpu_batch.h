@@ -23,6 +23,10 @@ struct RenderHook {
   /// After a step that did not end in an automatic reset, on the post-step state.
   void (*on_step)(void* user, int32_t env, Key episode_key, const LatentParams& p, LayoutView layout,
                   const LatentState& s, uint8_t* obs) = nullptr;
+  /// After a step that ends the episode, before its automatic reset, on the finished episode's last
+  /// state (the final observation goes to the hook's own buffer; `obs` is then overwritten by on_reset).
+  void (*on_final)(void* user, int32_t env, Key episode_key, const LatentParams& p, LayoutView layout,
+                   const LatentState& s) = nullptr;
 };
 
 struct CpuBatchOptions {

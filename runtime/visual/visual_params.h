@@ -7,7 +7,7 @@
 namespace kage {
 
 /// Capacities of the fixed-size lists below. The config lowering rejects configs beyond them.
-constexpr int32_t kMaxListEntries = 16;  ///< colour, shape-type and preset lists
+constexpr int32_t kMaxListEntries = 32;  ///< colour, shape-type and preset lists (SHAPE_COLORS alone has 21 names)
 constexpr int32_t kMaxLights = 5;        ///< the original always allocates 5 light slots (spec 8.2)
 constexpr int32_t kMaxStickyOffsets = 8; ///< explicit npc.sticky_x_offsets entries
 

@@ -1,0 +1,54 @@
+// kagec bench --cpu: environment steps per second of the CPU runtime, observations rendered.
+#include <chrono>
+#include <ostream>
+#include <thread>
+
+#include "compiler/cli_common.h"
+#include "compiler/environment.h"
+#include "runtime/rng.h"
+
+namespace kage {
+
+int cmd_bench(const std::vector<std::string>& args, CommandIo& io) {
+  CLI::App app("Measure environment steps per second (observations rendered).", "bench");
+  std::string config, asset_root;
+  bool cpu = false;
+  int envs = 64, steps = 200, warmup = 10;
+  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  app.add_option("config", config, "config file")->required();
+  app.add_flag("--cpu", cpu, "run the CPU runtime (the only backend of this command so far)")->required();
+  app.add_option("--envs", envs, "environments in the batch")->check(CLI::PositiveNumber);
+  app.add_option("--steps", steps, "timed steps of the whole batch")->check(CLI::PositiveNumber);
+  app.add_option("--warmup", warmup, "untimed steps before the timed ones")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", threads, "worker threads (default: all cores)")->check(CLI::PositiveNumber);
+  app.add_option("--asset-root", asset_root, "resolve asset paths against this directory");
+  if (auto code = parse_args(app, args, io)) return *code;
+  EnvironmentOptions options;
+  options.num_envs = envs;
+  options.num_threads = threads;
+  if (!asset_root.empty()) options.asset_root = asset_root;
+  EnvironmentResult opened = Environment::open(config, options);
+  if (!opened.ok()) {
+    io.err << opened.warnings << opened.error;
+    return kExitErrors;
+  }
+  CpuEnv& env = opened.env->env();
+  std::vector<uint64_t> seeds(envs);
+  for (int i = 0; i < envs; ++i) seeds[i] = static_cast<uint64_t>(i);
+  env.reset(seeds.data());
+  // Uniform random actions, drawn before timing so that only the environment is measured.
+  const int total = warmup + steps;
+  std::vector<int32_t> actions(static_cast<size_t>(total) * envs);
+  for (size_t i = 0; i < actions.size(); ++i) actions[i] = randint(Key{0, 1}, static_cast<uint32_t>(i), 0, 8);
+  for (int t = 0; t < warmup; ++t) env.step(actions.data() + static_cast<size_t>(t) * envs);
+  const auto start = std::chrono::steady_clock::now();
+  for (int t = warmup; t < total; ++t) env.step(actions.data() + static_cast<size_t>(t) * envs);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double rate = static_cast<double>(steps) * envs / seconds;
+  io.out << config << ": cpu, " << envs << " envs x " << steps << " steps on " << threads << " threads, "
+         << env.height() << "x" << env.width() << " observations: " << static_cast<long long>(rate)
+         << " env-steps/s (" << seconds << " s)\n";
+  return kExitOk;
+}
+
+}  // namespace kage
