@@ -68,7 +68,9 @@ TEST_CASE("a latent change fails certification", "[diff]") {
   CHECK(c.measured.count(Axis::Latent));
   CHECK(has_problem(c, "latent keys change (the hidden game differs): physics.gravity"));
   // The hitbox is latent although it sits under character.
-  CHECK(has_problem(certify_texts(kTrain, kTrain + "character: {width: 20}\n", std::nullopt), "character.width"));
+  CHECK(has_problem(certify_texts("character: {use_shape: true}\n", "character: {use_shape: true, width: 20}\n",
+                                  std::nullopt),
+                    "latent keys change (the hidden game differs): character.width"));
 }
 
 TEST_CASE("two visual axes fail unless the second is allowed", "[diff]") {
