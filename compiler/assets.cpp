@@ -90,8 +90,11 @@ class AssetResolver {
   }
 
   std::optional<AssetFile> hash_image(const std::string& file, Range at, const std::string& key) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) {
+    std::error_code ec;
+    std::ifstream in;
+    // Only regular files: a directory or a device such as /dev/zero named as an image is not one.
+    if (fs::is_regular_file(file, ec)) in.open(file, std::ios::binary);
+    if (!in.is_open() || !in) {
       diags_.report(Rule::AssetMissing, at, "asset file '" + file + "' (from '" + key + "') does not exist; fix the path",
                     "/" + key);
       return std::nullopt;

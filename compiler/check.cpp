@@ -16,6 +16,11 @@ std::string format_number(double v) {
   return s.str();
 }
 
+// "an integer", "a list".
+std::string with_article(const std::string& noun) {
+  return (noun.find_first_of("aeiou") == 0 ? "an " : "a ") + noun;
+}
+
 std::string quoted_list(const std::vector<std::string>& names) {
   std::string out;
   for (size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + names[i];
@@ -48,14 +53,15 @@ void check_name(const KeySchema& key, const NameTable& table, const DocNode& nod
 
 // One scalar against a value rule; returns false if it was reported.
 bool check_scalar(const KeySchema& key, const ValueRule& rule, const DocNode& node, DiagEngine& diags,
-                  const char* what) {
+                  const char* what_prefix) {
+  const std::string what = *what_prefix ? std::string(what_prefix) + " " : std::string();
   const Scalar v = scalar_value(node);
   const bool is_null = node.is_null() || std::holds_alternative<std::monostate>(v);
   auto type_error = [&](const std::string& extra) {
     std::string got = kind_name(node);
     if (node.is_scalar() && !is_null) got += " '" + node.text + "'";
     diags.report(Rule::SchemaType, node.range,
-                 std::string(what) + " '" + key.path + "' must be " + describe_types(rule.types) + ", not " + got +
+                 what + "'" + key.path + "' must be " + describe_types(rule.types) + ", not " + got +
                      extra,
                  key.pointer);
     return false;
@@ -80,12 +86,12 @@ bool check_scalar(const KeySchema& key, const ValueRule& rule, const DocNode& no
   }
   if (!std::isfinite(x)) {
     diags.report(Rule::SchemaNonFinite, node.range,
-                 std::string(what) + " '" + key.path + "' must be a finite number, not " + node.text, key.pointer);
+                 what + "'" + key.path + "' must be a finite number, not " + node.text, key.pointer);
     return false;
   }
   auto range_error = [&](const std::string& bound) {
     diags.report(Rule::SchemaRange, node.range,
-                 std::string(what) + " '" + key.path + "' must be " + bound + " (got " + node.text + ")", key.pointer);
+                 what + "'" + key.path + "' must be " + bound + " (got " + node.text + ")", key.pointer);
     return false;
   };
   if (rule.minimum && x < *rule.minimum) return range_error(">= " + format_number(*rule.minimum));
@@ -259,7 +265,7 @@ bool check_config(const ComposedConfig& config, const Schema& schema, DiagEngine
       if (e.value.is_null()) continue;  // a null section behaves as absent (spec 2.2)
       if (!e.value.is_map()) {
         diags.report(Rule::YamlNotMapping, e.value.range,
-                     "section '" + e.key + "' must be a mapping of keys to values, not a " + kind_name(e.value),
+                     "section '" + e.key + "' must be a mapping of keys to values, not " + with_article(kind_name(e.value)),
                      "/" + e.key);
         continue;
       }

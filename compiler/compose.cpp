@@ -74,7 +74,8 @@ class Composer {
     }
     if (!doc.is_map()) {
       diags_.report(Rule::YamlNotMapping, doc.range,
-                    std::string("a config must be a mapping of keys to values, not a ") + kind_name(doc));
+                    std::string("a config must be a mapping of keys to values, not ") +
+                        (std::string(kind_name(doc)).find_first_of("aeiou") == 0 ? "an " : "a ") + kind_name(doc));
       return std::nullopt;
     }
     ComposedConfig out;
@@ -88,7 +89,9 @@ class Composer {
     const Scalar target = scalar_value(ext->value);
     if (!std::holds_alternative<std::string>(target)) {
       diags_.report(Rule::SchemaType, ext->value.range,
-                    std::string("'extends' must be a path to a base config, not a ") + kind_name(ext->value),
+                    std::string("'extends' must be a path to a base config, not ") +
+                        (std::string(kind_name(ext->value)).find_first_of("aeiou") == 0 ? "an " : "a ") +
+                        kind_name(ext->value),
                     "/extends");
       out.root = strip_extends(std::move(doc));
       return out;

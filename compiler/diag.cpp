@@ -193,7 +193,7 @@ void print_json(const DiagEngine& engine, std::ostream& out) {
   doc["version"] = 1;
   doc["diagnostics"] = list;
   doc["summary"] = {{"errors", errors}, {"warnings", warnings}};
-  out << doc.dump(2) << '\n';
+  out << doc.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
 }
 
 }  // namespace kage

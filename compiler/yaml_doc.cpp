@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <regex>
@@ -61,7 +62,7 @@ Scalar scalar_value(const DocNode& node) {
     return t;  // out of int64 range: leave as text, the type check reports it
   }
   if (std::regex_match(t, kFloatRe) && t.find_first_of("0123456789") != std::string::npos)
-    return std::stod(strip_underscores(t));
+    return std::strtod(strip_underscores(t).c_str(), nullptr);  // 1e400 is inf, as in PyYAML (stod would throw)
   if (std::regex_match(t, kInfRe))
     return t[0] == '-' ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
   if (std::regex_match(t, kNanRe)) return std::numeric_limits<double>::quiet_NaN();
@@ -94,6 +95,14 @@ class Converter {
     DocNode out;
     const uint32_t begin = offset_of(n, fallback_offset);
     out.range = Range{Loc{file_, begin}, begin};
+    // Aliases share nodes; expanded, a few lines can name billions of them. Stop at a budget.
+    if (budget_ == 0) return out;
+    if (--budget_ == 0) {
+      diags_.report(Rule::YamlSyntax, Range{Loc{file_, begin}, begin},
+                    "the document expands to more than " + std::to_string(kNodeBudget) +
+                        " nodes (through aliases?); a config is far smaller");
+      return out;
+    }
     switch (n.Type()) {
       case YAML::NodeType::Undefined:
       case YAML::NodeType::Null:
@@ -153,23 +162,54 @@ class Converter {
     return std::min<uint32_t>(end, static_cast<uint32_t>(text_.size()));
   }
 
+  static constexpr size_t kNodeBudget = 1000000;
+  size_t budget_ = kNodeBudget;
   const SourceManager& sm_;
   FileId file_;
   DiagEngine& diags_;
   const std::string& text_;
 };
 
+// The offset of the first byte that does not belong to a well-formed UTF-8 sequence.
+std::optional<size_t> invalid_utf8_offset(const std::string& text) {
+  size_t i = 0;
+  while (i < text.size()) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    if (len == 0 || (len == 2 && c < 0xC2) || (len == 4 && c > 0xF4) || i + len > text.size()) return i;
+    for (size_t k = 1; k < len; ++k)
+      if ((static_cast<unsigned char>(text[i + k]) & 0xC0) != 0x80) return i;
+    if (len == 3) {
+      const auto c1 = static_cast<unsigned char>(text[i + 1]);
+      if ((c == 0xE0 && c1 < 0xA0) || (c == 0xED && c1 >= 0xA0)) return i;  // overlong, surrogate
+    }
+    if (len == 4) {
+      const auto c1 = static_cast<unsigned char>(text[i + 1]);
+      if ((c == 0xF0 && c1 < 0x90) || (c == 0xF4 && c1 >= 0x90)) return i;
+    }
+    i += len;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<DocNode> parse_yaml(const SourceManager& sources, FileId file, DiagEngine& diags) {
   const std::string& text = sources.text(file);
+  // PyYAML rejects bytes that are not UTF-8; so does the original (and JSON output could not hold them).
+  if (const auto bad = invalid_utf8_offset(text)) {
+    const uint32_t off = static_cast<uint32_t>(*bad);
+    diags.report(Rule::YamlSyntax, Range{Loc{file, off}, off + 1}, "invalid YAML: the file is not valid UTF-8");
+    return std::nullopt;
+  }
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     uint32_t off = e.mark.pos >= 0 ? static_cast<uint32_t>(e.mark.pos) : 0;
     off = std::min<uint32_t>(off, static_cast<uint32_t>(text.size()));
-    diags.report(Rule::YamlSyntax, Range{Loc{file, off}, off + 1}, "invalid YAML: " + e.msg);
+    const uint32_t end = std::min<uint32_t>(off + 1, static_cast<uint32_t>(text.size()));
+    diags.report(Rule::YamlSyntax, Range{Loc{file, off}, end}, "invalid YAML: " + e.msg);
     return std::nullopt;
   }
   Converter conv(sources, file, diags);
