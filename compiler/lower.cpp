@@ -8,15 +8,6 @@
 
 #include "compiler/schema.h"
 
-// nlohmann 3.11 has no std::optional conversion, which spec_fields.h needs for nullable keys; null is
-// skipped before get<>() is called, so only the value case is needed.
-namespace nlohmann {
-template <class T>
-struct adl_serializer<std::optional<T>> {
-  static void from_json(const json& j, std::optional<T>& out) { out = j.get<T>(); }
-};
-}  // namespace nlohmann
-
 #include "compiler/generated/spec_fields.h"
 #include "compiler/resolve.h"
 #include "runtime/visual/visual_state.h"

@@ -175,6 +175,12 @@ void read_field(const nlohmann::json& j, const char* key, T& out) {
   if (!v.is_null()) out = v.get<T>();
 }
 
+template <class T>
+void read_field(const nlohmann::json& j, const char* key, std::optional<T>& out) {
+  const nlohmann::json& v = j.at(key);
+  if (!v.is_null()) out = v.get<T>();
+}
+
 /// Reads the `config` object of a canonical Spec.
 inline Config from_json(const nlohmann::json& c) {
   Config out;

@@ -98,6 +98,8 @@ int main(int argc, char** argv) {
   for (const auto& [section, fields] : sections) o << "  " << struct_name(section) << " " << section << ";\n";
   o << "};\n\n/// Number of keys in a Spec.\ninline constexpr size_t kFieldCount = " << count << ";\n\n";
   o << "template <class T>\nvoid read_field(const nlohmann::json& j, const char* key, T& out) {\n"
+       "  const nlohmann::json& v = j.at(key);\n  if (!v.is_null()) out = v.get<T>();\n}\n\n"
+       "template <class T>\nvoid read_field(const nlohmann::json& j, const char* key, std::optional<T>& out) {\n"
        "  const nlohmann::json& v = j.at(key);\n  if (!v.is_null()) out = v.get<T>();\n}\n\n";
   o << "/// Reads the `config` object of a canonical Spec.\ninline Config from_json(const nlohmann::json& c) {\n"
        "  Config out;\n";
