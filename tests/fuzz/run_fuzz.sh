@@ -15,6 +15,8 @@ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DKAGE_BUILD_FUZZERS=ON \
   -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer" >/dev/null
 cmake --build "$build" --target fuzz_front_end -j"${KAGE_FUZZ_JOBS:-2}"
+fuzzer="$build/tests/compiler/fuzz_front_end"
+[ -x "$fuzzer" ] || { echo "run_fuzz.sh: $fuzzer was not built" >&2; exit 2; }
 
 mkdir -p "$corpus" "$artifacts"
 find "$root/configs" "$root/tests/lint" -name '*.yaml' -type f | while read -r f; do
@@ -23,7 +25,7 @@ done
 
 cd "$build"  # the target reads nothing from disk except through asset paths, which never exist
 status=0
-"$build/fuzz_front_end" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -max_len=8192 \
+"$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -max_len=8192 \
   -artifact_prefix="$artifacts/" -print_final_stats=1 "$corpus" || status=$?
 if [ "$status" -ne 0 ]; then
   echo "run_fuzz.sh: the fuzzer found a problem (exit $status); inputs are in $artifacts" >&2
