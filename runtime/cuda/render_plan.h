@@ -1,0 +1,57 @@
+// How a config's frames are rendered on the GPU: per pixel in registers, or with the neighbourhood
+// filters (blur, sharpen, pixelate, cyberpunk's sharpen) from a float32 frame in shared memory.
+// Read by the kernels (a constant in a specialized build) and by the host that sizes the launch.
+#pragma once
+
+#include "runtime/kage_hd.h"
+#include "runtime/visual/filter_ops.h"
+#include "runtime/visual/visual_params.h"
+
+namespace kage {
+
+/// Capacities of a rendering block's shared state (kernels.cuh BlockShared): layout bytes and screen
+/// columns. DeviceBatch rejects configs beyond them.
+constexpr int32_t kMaxLayoutBytes = 4096;
+constexpr int32_t kMaxScreenWidth = 1024;
+
+/// Pixels per thread: one 48-byte run of a row (three 16-byte stores) in the register path, a
+/// strided set of 16 pixels in the frame-pass path.
+constexpr int32_t kPixelsPerThread = 16;
+/// Threads of a register-path block (one frame per block).
+constexpr int32_t kRegisterPathThreads = 256;
+/// Largest block of the frame-pass path; every pixel of the frame belongs to one of its threads.
+constexpr int32_t kFramePassMaxThreads = 1024;
+
+/// Whether any frame pass can run: a sharpening preset in pop_filter_list or pop_filter, blur,
+/// sharpen or pixelate (spec 7.1 steps A, 8-10).
+KAGE_HD bool needs_frame_passes(const VisualParams& p) {
+  bool preset_sharpen = preset_sharpen_amount(p.pop_filter) > 0.0f;
+  for (int32_t i = 0; i < p.pop_filter_count && i < kMaxListEntries; ++i) {
+    preset_sharpen = preset_sharpen || preset_sharpen_amount(p.pop_filter_list[i]) > 0.0f;
+  }
+  return preset_sharpen || p.blur_sigma > 0.0f || p.sharpen_amount > 0.0f || p.pixelate_factor > 1;
+}
+
+/// Whether the register path can store whole 16-pixel runs (each row a multiple of 16 pixels).
+KAGE_HD bool register_path_vectorized(const VisualParams& p) { return p.W % kPixelsPerThread == 0; }
+
+/// Threads per rendering block.
+KAGE_HD int32_t render_threads(const VisualParams& p) {
+  if (!needs_frame_passes(p)) return kRegisterPathThreads;
+  const int32_t per = (p.H * p.W + kPixelsPerThread - 1) / kPixelsPerThread;
+  return (per + 31) / 32 * 32;
+}
+
+/// Dynamic shared memory of a rendering block: the float32 frame of the frame-pass path, or the
+/// register path's staging slots (16 packed pixels + 1 padding word per thread).
+KAGE_HD int32_t render_dynamic_smem_bytes(const VisualParams& p) {
+  return needs_frame_passes(p) ? p.H * p.W * 3 * static_cast<int32_t>(sizeof(float))
+                               : kRegisterPathThreads * (kPixelsPerThread + 1) * static_cast<int32_t>(sizeof(uint32_t));
+}
+
+/// Whether the GPU kernels support this frame size: the frame-pass path holds one frame per block.
+KAGE_HD bool render_supported(const VisualParams& p) {
+  return p.H > 0 && p.W > 0 && p.W <= kMaxScreenWidth && (!needs_frame_passes(p) || render_threads(p) <= kFramePassMaxThreads);
+}
+
+}  // namespace kage
