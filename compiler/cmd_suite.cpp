@@ -4,20 +4,46 @@
 #include <ostream>
 
 #include "compiler/cli_common.h"
+#include "compiler/isolation.h"
 #include "compiler/suite.h"
 
 namespace kage {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+/// Adds "dynamic_isolation" to each pair's certificate (compiler/isolation.h); returns the failures.
+size_t add_isolation_evidence(const SuiteReport& report, Json& json, std::ostream& out) {
+  size_t failures = 0;
+  for (size_t i = 0; i < report.results.size(); ++i) {
+    const PairResult& r = report.results[i];
+    if (!r.train || !r.eval) continue;
+    IsolationOptions options;
+    options.latent_pair = r.pair->axis == Axis::Latent;
+    const IsolationEvidence ev = dynamic_isolation(*r.train, *r.eval, config_schema(), options);
+    json["pairs"][i]["dynamic_isolation"] = ev.to_json(options);
+    failures += ev.ok() ? 0 : 1;
+    out << "  " << r.pair->name << ": dynamics " << (ev.dynamics_source_identical ? "identical" : "DIFFER")
+        << ", trajectories " << (ev.trajectories_identical ? "identical" : "DIVERGE") << ", mean |train - eval| "
+        << ev.mean_abs_pixel_diff << (ev.ok() ? "" : "  FAILED") << '\n';
+    for (const std::string& p : ev.problems) out << "    " << p << '\n';
+  }
+  return failures;
+}
+
+}  // namespace
+
 int cmd_suite(const std::vector<std::string>& args, CommandIo& io) {
   CLI::App app("Lint and certify every train/eval pair of a suite manifest.", "suite");
   std::string manifest, out_dir;
-  bool verbose = false;
+  bool verbose = false, compile = false;
   DiagOptions opts;
   app.add_option("manifest", manifest, "suite manifest (YAML)")->required();
   app.add_option("-o,--output", out_dir, "directory for report.json and one certificate per pair (default: out/<suite>)");
   app.add_flag("-v,--verbose", verbose, "also print the warnings of every config");
+  app.add_flag("--compile", compile,
+               "also gather dynamic isolation evidence per pair (generated dynamics, latent trajectories, frames)");
   opts.add_to(app, false);
   if (auto code = parse_args(app, args, io)) return *code;
   SourceManager sources;
@@ -38,7 +64,9 @@ int cmd_suite(const std::vector<std::string>& args, CommandIo& io) {
   const fs::path dir = out_dir.empty() ? fs::path("out") / suite->name : fs::path(out_dir);
   std::error_code ec;
   fs::create_directories(dir / "certificates", ec);
-  const Json json = suite_report_json(*suite, report);
+  Json json = suite_report_json(*suite, report);
+  size_t isolation_failures = 0;
+  if (compile) isolation_failures = add_isolation_evidence(report, json, io.out);
   std::ofstream f(dir / "report.json", std::ios::binary);
   f << json.dump(2) << '\n';
   for (const Json& pair : json.at("pairs")) {
@@ -53,7 +81,7 @@ int cmd_suite(const std::vector<std::string>& args, CommandIo& io) {
     return kExitErrors;
   }
   io.out << "report: " << (dir / "report.json").string() << '\n';
-  return report.passed() == report.results.size() ? kExitOk : kExitErrors;
+  return report.passed() == report.results.size() && isolation_failures == 0 ? kExitOk : kExitErrors;
 }
 
 }  // namespace kage

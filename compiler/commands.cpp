@@ -12,12 +12,14 @@ const std::vector<Command>& commands() {
       {"lint", "check config files and report diagnostics", cmd_lint},
       {"resolve", "print the canonical Spec of a config and its SHA-256", cmd_resolve},
       {"diff", "list the effective differences of a train/eval pair by axis; --certify checks one axis", cmd_diff},
+      {"compile", "generate a config's specialized source and build its kernels (fatbin, host library)", cmd_compile},
       {"suite", "lint and certify every pair of a suite manifest", cmd_suite},
       {"rules", "list every diagnostic rule with its severity", cmd_rules},
       {"schema", "print the configuration JSON Schema (for editors)", cmd_schema},
       {"render", "run one environment and write its frames as PNG, GIF or a contact sheet", cmd_render},
       {"bench", "measure environment steps per second (--cpu)", cmd_bench},
       {"golden", "check the runtime against the reference data of the original (golden check)", cmd_golden},
+      {"docs", "print a reference page: config-keys or diagnostics", cmd_docs},
   };
   return table;
 }

@@ -42,5 +42,7 @@ int cmd_schema(const std::vector<std::string>& args, CommandIo& io);
 int cmd_render(const std::vector<std::string>& args, CommandIo& io);
 int cmd_bench(const std::vector<std::string>& args, CommandIo& io);
 int cmd_golden(const std::vector<std::string>& args, CommandIo& io);
+int cmd_compile(const std::vector<std::string>& args, CommandIo& io);
+int cmd_docs(const std::vector<std::string>& args, CommandIo& io);
 
 }  // namespace kage

@@ -1,0 +1,169 @@
+// kagec compile CONFIG -o DIR: Spec -> lowered params -> generated source -> fatbin (nvcc) and host
+// library (c++), with params.bin, assets.bin, spec.json and a manifest naming every file's SHA-256.
+#include <filesystem>
+#include <fstream>
+#include <ostream>
+#include <sstream>
+
+#include "compiler/build.h"
+#include "compiler/cli_common.h"
+#include "compiler/codegen.h"
+#include "compiler/lower.h"
+#include "runtime/host/sha256.h"
+#include "runtime/host/specialized_assets.h"
+
+namespace kage {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool write_file(const fs::path& path, std::string_view bytes) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  return static_cast<bool>(f);
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+/// params.bin: the LatentParams words, then the VisualParams words (little-endian).
+std::string params_blob(const LoweredConfig& lowered) {
+  std::string out;
+  for (const auto& words : {param_words(lowered.latent), param_words(lowered.visual)}) {
+    for (uint32_t w : words) {
+      for (int b = 0; b < 4; ++b) out.push_back(static_cast<char>((w >> (8 * b)) & 0xffu));
+    }
+  }
+  return out;
+}
+
+/// The last lines of a tool's output, for a failure message.
+std::string tail(const std::string& s, size_t lines) {
+  size_t at = s.size();
+  for (size_t n = 0; n <= lines && at > 0; ++n) at = s.rfind('\n', at - 1) == std::string::npos ? 0 : s.rfind('\n', at - 1);
+  return s.substr(at);
+}
+
+}  // namespace
+
+int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
+  CLI::App app("Generate a config's specialized source and build its GPU and CPU kernels.", "compile");
+  std::string file, out_dir, source_name;
+  bool no_build = false, no_gpu = false, no_host = false;
+  DiagOptions opts;
+  app.add_option("file", file, "config file")->required();
+  app.add_option("-o,--output", out_dir, "output directory")->required();
+  app.add_flag("--no-build", no_build, "only generate the source, params, Spec and manifest (no builds, no assets.bin)");
+  app.add_option("--source-name", source_name, "file name of the generated source (default kage_<spec hash>.cu)");
+  app.add_flag("--no-gpu", no_gpu, "skip nvcc (kernels.fatbin)");
+  app.add_flag("--no-host", no_host, "skip the host compiler (kernels_host.so)");
+  opts.add_to(app, false);
+  if (auto code = parse_args(app, args, io)) return *code;
+  SourceManager sources;
+  DiagEngine diags(sources);
+  if (!opts.apply(diags, io)) return kExitUsage;
+  DiskFileReader reader;
+  const auto spec = analyze_file(file, opts.resolve_options(), sources, reader, diags);
+  print_text(diags, io.err, io.err_is_terminal);
+  if (!spec || diags.has_errors()) {
+    io.err << "kagec compile: no Spec: fix the errors above\n";
+    return kExitErrors;
+  }
+  const LowerResult lowered = lower_spec(*spec);
+  if (!lowered.ok()) {
+    io.err << lowered.error_text() << "kagec compile: the runtime cannot hold this config\n";
+    return kExitErrors;
+  }
+  GeneratedSource gen = generate_source({spec->sha256(), lowered.config->latent, lowered.config->visual});
+
+  if (!source_name.empty()) gen.file_name = source_name;
+  const fs::path dir(out_dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  bool written = write_file(dir / gen.file_name, gen.text) && write_file(dir / "params.bin", params_blob(*lowered.config)) &&
+                 write_file(dir / "spec.json", spec->canonical_text());
+  std::vector<std::string> files = {gen.file_name, "params.bin", "spec.json"};
+  if (!no_build) {
+    AssetPackResult assets = load_asset_pack(lowered.config->assets);
+    if (!assets.ok()) {
+      io.err << "kagec compile: " << assets.error << '\n';
+      return kExitErrors;
+    }
+    for (const std::string& w : assets.warnings) io.err << "kagec compile: warning: " << w << '\n';
+    written = written && write_file(dir / "assets.bin", serialize_asset_pack(*assets.pack));
+    files.push_back("assets.bin");
+  }
+
+  Json builds = Json::object();
+  const std::string include_dir = runtime_include_dir();
+  const std::string nvcc = find_nvcc(), cxx = find_host_cxx();
+  auto build = [&](const char* name, const char* out_name, bool skip, const std::string& tool, const char* missing,
+                   auto&& run) {
+    Json b = {{"output", out_name}};
+    if (no_build || skip) {
+      b["status"] = "skipped";
+      b["note"] = no_build ? "--no-build" : "disabled on the command line";
+    } else if (tool.empty()) {
+      b["status"] = "skipped";
+      b["note"] = missing;
+    } else {
+      const ToolRun r = run(tool, (dir / gen.file_name).string(), (dir / out_name).string(), include_dir);
+      io.err << "kagec compile: " << name << ": " << (r.ok() ? "built" : "FAILED") << " in " << r.seconds << " s\n";
+      if (r.ok()) {
+        b["status"] = "built";
+        files.push_back(out_name);
+      } else {
+        b["status"] = "failed";
+        b["note"] = tail(r.output, 20);
+        io.err << r.output;
+      }
+    }
+    builds[name] = b;
+  };
+  build("gpu", "kernels.fatbin", no_gpu, nvcc, "nvcc not found ($CUDACXX, $CUDA_HOME/bin, /usr/local/cuda/bin, PATH)",
+        build_fatbin);
+  build("host", "kernels_host.so", no_host, cxx, "no host C++ compiler ($KAGE_HOST_CXX, $CXX, c++)",
+        build_host_library);
+
+  Json file_list = Json::array();
+  for (const std::string& f : files) {
+    const std::string bytes = read_file(dir / f);
+    file_list.push_back({{"name", f}, {"bytes", bytes.size()}, {"sha256", sha256_hex(bytes)}});
+  }
+  const std::string nvrtc = nvrtc_version();
+  const Json manifest = {
+      {"kagec_manifest", 1},
+      {"spec_sha256", spec->sha256()},
+      {"codegen_version", kCodegenVersion},
+      {"template_sha256", gen.template_hash},
+      {"latent_section_sha256", gen.latent_hash},
+      {"config_type", gen.config_name},
+      {"source", gen.file_name},
+      {"arch", kCudaArch},
+      {"params", {{"file", "params.bin"}, {"latent_bytes", sizeof(LatentParams)}, {"visual_offset", sizeof(LatentParams)},
+                  {"visual_bytes", sizeof(VisualParams)}}},
+      {"toolchain",
+       {{"nvcc", nvcc.empty() ? Json(nullptr) : Json(tool_version(nvcc))},
+        {"nvrtc", nvrtc.empty() ? Json(nullptr) : Json(nvrtc)},
+        {"host_cxx", cxx.empty() ? Json(nullptr) : Json(tool_version(cxx))}}},
+      {"flags", {{"nvcc", nvcc_flags()}, {"host", host_flags()}}},
+      {"builds", builds},
+      {"files", file_list},
+  };
+  written = written && write_file(dir / "manifest.json", manifest.dump(2) + "\n");
+  if (!written) {
+    io.err << "kagec compile: cannot write under '" << dir.string() << "'\n";
+    return kExitErrors;
+  }
+  bool failed = false;
+  for (const auto& [name, b] : builds.items()) failed |= b.at("status") == "failed";
+  io.out << (dir / gen.file_name).string() << '\n';
+  return failed ? kExitErrors : kExitOk;
+}
+
+}  // namespace kage

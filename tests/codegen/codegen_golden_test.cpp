@@ -1,0 +1,128 @@
+// Codegen goldens and properties: the committed simplest.expected.cu, byte-identical reruns, and a
+// latent section that depends on the latent parameters only.
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "compiler/codegen.h"
+#include "compiler/lower.h"
+#include "compiler/resolve.h"
+
+namespace {
+
+const std::string kRoot = std::string(KAGE_SOURCE_DIR) + "/";
+
+struct Lowered {
+  std::string hash;
+  kage::LoweredConfig config;
+};
+
+/// Front end + lowering of a config under the source tree (asset paths as `kagec compile` run from the root).
+Lowered lower_file(const std::string& rel) {
+  kage::SourceManager sources;
+  kage::DiagEngine diags(sources);
+  kage::DiskFileReader reader;
+  kage::ResolveOptions options;
+  const auto spec = kage::analyze_file(kRoot + rel, options, sources, reader, diags);
+  INFO(rel);
+  REQUIRE(spec.has_value());
+  REQUIRE(!diags.has_errors());
+  kage::LowerResult lowered = kage::lower_spec(*spec);
+  INFO(lowered.error_text());
+  REQUIRE(lowered.ok());
+  return {spec->sha256(), *lowered.config};
+}
+
+kage::GeneratedSource generate_file(const std::string& rel) {
+  const Lowered l = lower_file(rel);
+  return kage::generate_source({l.hash, l.config.latent, l.config.visual});
+}
+
+std::string read(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("the generated source of simplest.yaml matches its golden", "[codegen][golden]") {
+  const kage::GeneratedSource g = generate_file("configs/throughput/simplest.yaml");
+  const std::string golden = kRoot + "tests/codegen/simplest.expected.cu";
+  const char* update = std::getenv("KAGE_UPDATE_GOLDENS");
+  if (update && std::string(update) == "1") {
+    std::ofstream(golden, std::ios::binary) << g.text;
+    WARN("rewrote " << golden);
+  }
+  const std::string expected = read(golden);
+  if (g.text != expected) {
+    std::ofstream(golden + ".actual", std::ios::binary) << g.text;
+    FAIL("generated source differs from " << golden << "; see " << golden
+                                          << ".actual (KAGE_UPDATE_GOLDENS=1 ctest rewrites the golden)");
+  }
+  // Thin and self-describing: no absolute paths, the hashes in the header, the instantiations present.
+  CHECK(g.text.find(KAGE_SOURCE_DIR) == std::string::npos);
+  CHECK(g.text.find("// spec: sha256:" + g.file_name.substr(5, 16)) != std::string::npos);
+  CHECK(g.text.find("KAGE_INSTANTIATE_KERNELS(kage::generated::" + g.config_name + ")") != std::string::npos);
+  CHECK(g.text.find("KAGE_INSTANTIATE_HOST(kage::generated::" + g.config_name + ")") != std::string::npos);
+  CHECK(g.text.find(g.latent_section) != std::string::npos);
+}
+
+TEST_CASE("codegen is deterministic", "[codegen]") {
+  for (const char* rel : {"configs/throughput/simplest.yaml", "configs/throughput/hardest.yaml"}) {
+    const kage::GeneratedSource a = generate_file(rel);
+    const kage::GeneratedSource b = generate_file(rel);
+    INFO(rel);
+    CHECK(a.text == b.text);
+    CHECK(a.latent_hash == b.latent_hash);
+    CHECK(a.text.size() > 2000);
+  }
+}
+
+TEST_CASE("the latent section depends only on the latent parameters", "[codegen][isolation]") {
+  Lowered base = lower_file("configs/throughput/simplest.yaml");
+  const std::string section = kage::generate_latent_section(base.config.latent);
+  // Any visual change leaves it byte-identical; a latent change does not.
+  kage::VisualParams v = base.config.visual;
+  v.brightness = 0.25f;
+  v.bg_mode = kage::BackgroundMode::kNoise;
+  const kage::GeneratedSource a = kage::generate_source({base.hash, base.config.latent, base.config.visual});
+  const kage::GeneratedSource b = kage::generate_source({base.hash, base.config.latent, v});
+  CHECK(a.latent_section == section);
+  CHECK(b.latent_section == section);
+  CHECK(a.text != b.text);
+  kage::LatentParams l = base.config.latent;
+  l.gravity *= 2.0f;
+  CHECK(kage::generate_latent_section(l) != section);
+}
+
+TEST_CASE("param words round-trip the lowered structs", "[codegen]") {
+  const Lowered l = lower_file("configs/throughput/hardest.yaml");
+  const std::vector<uint32_t> w = kage::param_words(l.config.latent);
+  REQUIRE(w.size() * 4 == sizeof(kage::LatentParams));
+  kage::LatentParams back{};
+  std::memcpy(&back, w.data(), sizeof back);
+  CHECK(back.gravity == l.config.latent.gravity);
+  CHECK(back.length == l.config.latent.length);
+  CHECK(back.dist_to_success == l.config.latent.dist_to_success);
+}
+
+TEST_CASE("param words keep every byte of the colour lists", "[codegen]") {
+  // Regression: GCC 12's __builtin_clear_padding zeroed bytes of bg_colors[2] in VisualParams.
+  kage::VisualParams v = kage::identity_visual_params(64, 64);
+  for (int i = 0; i < kage::kMaxListEntries; ++i) v.bg_colors[i] = kage::Rgb{uint8_t(200 + i), uint8_t(10 + i), uint8_t(60 + i)};
+  const std::vector<uint32_t> w = kage::param_words(v);
+  kage::VisualParams back{};
+  std::memcpy(&back, w.data(), sizeof back);
+  for (int i = 0; i < kage::kMaxListEntries; ++i) {
+    INFO(i);
+    CHECK(back.bg_colors[i].r == v.bg_colors[i].r);
+    CHECK(back.bg_colors[i].g == v.bg_colors[i].g);
+    CHECK(back.bg_colors[i].b == v.bg_colors[i].b);
+  }
+}

@@ -1,0 +1,16 @@
+# Runs examples/minimal on CONFIG (generic CPU path) and on `kagec compile CONFIG --no-gpu` (generated
+# host library) and requires identical output: same returns, same observation checksum.
+execute_process(COMMAND ${KAGEC} compile ${CONFIG} -o ${OUT} --no-gpu RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "kagec compile failed: ${err}")
+endif()
+execute_process(COMMAND ${EXAMPLE} ${CONFIG} RESULT_VARIABLE rc1 OUTPUT_VARIABLE yaml ERROR_VARIABLE e1)
+execute_process(COMMAND ${EXAMPLE} ${OUT} RESULT_VARIABLE rc2 OUTPUT_VARIABLE compiled ERROR_VARIABLE e2)
+message(STATUS "yaml:     ${yaml}")
+message(STATUS "compiled: ${compiled}")
+if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0)
+  message(FATAL_ERROR "example failed: ${e1}${e2}")
+endif()
+if(NOT yaml STREQUAL compiled OR yaml STREQUAL "")
+  message(FATAL_ERROR "the compiled dir and the YAML disagree")
+endif()
