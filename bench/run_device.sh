@@ -13,6 +13,8 @@ if [ ! -x "$BUILD/bench/kage_gpu_bench" ]; then
   cmake -S . -B "$BUILD" -G Ninja -DKAGE_BUILD_FRONTEND=OFF -DCMAKE_BUILD_TYPE=Release >"$OUT/build.log" 2>&1 &&
     ninja -C "$BUILD" kage_gpu_bench >>"$OUT/build.log" 2>&1 || { tail -50 "$OUT/build.log"; exit 1; }
 fi
+# NVRTC is opened at run time; the toolkit directory is often not on the loader path.
+export LD_LIBRARY_PATH=/usr/local/cuda/lib64:${LD_LIBRARY_PATH:-}
 export KAGE_CACHE_DIR=/tmp/kage-cache
 rm -rf "$KAGE_CACHE_DIR"
 "$BUILD/bench/kage_gpu_bench" "$BUILD/bench" "$BUILD/data/assets.bin" --nvrtc-root "$PWD" "$@" 2>&1 | tee "$OUT/bench.log"

@@ -96,4 +96,31 @@ KAGE_HD int32_t randint(Key k, uint32_t i, int32_t lo, int32_t hi) {
   return lo + static_cast<int32_t>(off);
 }
 
+
+/// Four 32-bit words of Philox-4x32-10 (Salmon et al. 2011) for counter (c0, c1, c2, c3) under key k:
+/// a second counter-based generator, about 4x cheaper per word than threefry2x32 (10 rounds of two
+/// 32 x 32 -> 64-bit products), for per-pixel noise where one Threefry block per sample dominated the
+/// frame time. A pure function of (key, counter) like every draw here.
+struct Words4 {
+  uint32_t w[4];
+};
+
+KAGE_HD Words4 philox4x32(Key k, uint32_t c0, uint32_t c1, uint32_t c2 = 0u, uint32_t c3 = 0u) {
+  uint32_t k0 = k.k0, k1 = k.k1;
+#pragma unroll
+  for (int r = 0; r < 10; ++r) {
+    const uint64_t p0 = static_cast<uint64_t>(0xD2511F53u) * c0;
+    const uint64_t p1 = static_cast<uint64_t>(0xCD9E8D57u) * c2;
+    const uint32_t hi0 = static_cast<uint32_t>(p0 >> 32), lo0 = static_cast<uint32_t>(p0);
+    const uint32_t hi1 = static_cast<uint32_t>(p1 >> 32), lo1 = static_cast<uint32_t>(p1);
+    c0 = hi1 ^ c1 ^ k0;
+    c1 = lo1;
+    c2 = hi0 ^ c3 ^ k1;
+    c3 = lo0;
+    k0 += 0x9E3779B9u;
+    k1 += 0xBB67AE85u;
+  }
+  return Words4{{c0, c1, c2, c3}};
+}
+
 }  // namespace kage

@@ -64,15 +64,15 @@ KAGE_HD void chain_head_pixel(const VisualParams& p, const float* jitter_m, floa
 
 /// Main-chain steps 11-14 at pixel (r, c) (gaussian and Poisson noise, vignette, radial light).
 KAGE_HD void chain_tail_pixel(const VisualParams& p, const FilterKeys& keys, int32_t r, int32_t c, float* f) {
-  const uint32_t base = static_cast<uint32_t>((r * p.W + c) * 3);
+  const uint32_t pixel = static_cast<uint32_t>(r * p.W + c);
   if (p.gaussian_noise_std > 0.0f) {
-    for (uint32_t ch = 0; ch < 3; ++ch) {
-      f[ch] = clampf(f[ch] + p.gaussian_noise_std * normal(keys.gaussian, base + ch), 0.0f, 255.0f);
-    }
+    float z[3];
+    pixel_normals3(keys.gaussian, pixel, z);
+    for (uint32_t ch = 0; ch < 3; ++ch) f[ch] = clampf(f[ch] + p.gaussian_noise_std * z[ch], 0.0f, 255.0f);
   }
   if (p.poisson_noise_scale > 0.0f) {
     for (uint32_t ch = 0; ch < 3; ++ch) {
-      const int32_t n = poisson(fold(keys.poisson, base + ch), f[ch] * p.poisson_noise_scale);
+      const int32_t n = poisson(keys.poisson, pixel * 3 + ch, f[ch] * p.poisson_noise_scale);
       f[ch] = clampf(static_cast<float>(n) / p.poisson_noise_scale, 0.0f, 255.0f);
     }
   }
