@@ -3,18 +3,27 @@
 #include <catch2/catch.hpp>
 
 #include <cstdlib>
+#include <optional>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string>
 
 #include "compiler/codegen.h"
+#include "compiler/isolation.h"
 #include "compiler/lower.h"
 #include "compiler/resolve.h"
 
 namespace {
 
 const std::string kRoot = std::string(KAGE_SOURCE_DIR) + "/";
+
+std::optional<kage::Spec> spec_of(const std::string& rel) {
+  kage::SourceManager sources;
+  kage::DiagEngine diags(sources);
+  kage::DiskFileReader reader;
+  return kage::analyze_file(kRoot + rel, kage::ResolveOptions{}, sources, reader, diags);
+}
 
 struct Lowered {
   std::string hash;
@@ -125,4 +134,32 @@ TEST_CASE("param words keep every byte of the colour lists", "[codegen]") {
     CHECK(back.bg_colors[i].g == v.bg_colors[i].g);
     CHECK(back.bg_colors[i].b == v.bg_colors[i].b);
   }
+}
+
+TEST_CASE("isolation evidence holds for a visual pair and fails for a latent change", "[codegen][isolation]") {
+  const auto simplest = spec_of("configs/throughput/simplest.yaml");
+  const auto hardest = spec_of("configs/throughput/hardest.yaml");
+  const auto variant = spec_of("configs/golden/variant.yaml");
+  REQUIRE(simplest);
+  REQUIRE(hardest);
+  REQUIRE(variant);
+  kage::IsolationOptions options;
+  options.steps = 60;
+  // simplest -> hardest changes every visual axis and nothing latent.
+  const kage::IsolationEvidence visual = kage::dynamic_isolation(*simplest, *hardest, kage::config_schema(), options);
+  INFO(visual.to_json(options).dump());
+  CHECK(visual.ok());
+  CHECK(visual.dynamics_source_identical);
+  CHECK(visual.trajectories_identical);
+  CHECK(visual.mean_abs_pixel_diff > 1.0);
+  // The golden variant changes physics: every dynamic check must notice.
+  const kage::IsolationEvidence latent = kage::dynamic_isolation(*simplest, *variant, kage::config_schema(), options);
+  CHECK_FALSE(latent.ok());
+  CHECK_FALSE(latent.latent_spec_equal);
+  CHECK_FALSE(latent.dynamics_source_identical);
+  CHECK(latent.first_divergent_step >= 0);
+  // The same config on both sides: identical frames are reported as a failure.
+  const kage::IsolationEvidence same = kage::dynamic_isolation(*simplest, *simplest, kage::config_schema(), options);
+  CHECK_FALSE(same.frames_differ);
+  CHECK_FALSE(same.ok());
 }
