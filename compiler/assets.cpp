@@ -71,6 +71,11 @@ class AssetResolver {
     return parent_dir(sources_.name(node.range.begin.file));
   }
 
+  std::string pointer_of(const std::string& path) const {
+    const KeySchema* k = schema_.find(path);
+    return k ? k->pointer : std::string();
+  }
+
   const DocNode* node_of(const char* path) const {
     const KeySchema* k = schema_.find(path);
     return k ? find_key(config_.root, *k) : nullptr;
@@ -96,7 +101,7 @@ class AssetResolver {
     if (fs::is_regular_file(file, ec)) in.open(file, std::ios::binary);
     if (!in.is_open() || !in) {
       diags_.report(Rule::AssetMissing, at, "asset file '" + file + "' (from '" + key + "') does not exist; fix the path",
-                    "/" + key);
+                    pointer_of(key));
       return std::nullopt;
     }
     std::ostringstream buf;
@@ -109,7 +114,7 @@ class AssetResolver {
       diags_.report(Rule::AssetUnreadable, at,
                     "asset file '" + file + "' is not a readable PNG, JPEG or BMP image (" +
                         (stbi_failure_reason() ? stbi_failure_reason() : "unknown format") + "); replace it",
-                    "/" + key);
+                    pointer_of(key));
       return std::nullopt;
     }
     return AssetFile{display_path(file), sha256_hex(bytes), w, h};
@@ -119,37 +124,47 @@ class AssetResolver {
     const char* paths_key = g.sources[0];
     const char* dir_key = g.sources[1];
     const char* file_key = g.sources[2];
-    std::vector<std::pair<std::string, Range>> files;
+    struct Source {
+      std::string file;
+      Range at;
+      const char* key;
+    };
+    std::vector<Source> files;
     const Json& list = spec_.value(paths_key);
     if (list.is_array() && !list.empty()) {
-      for (size_t i = 0; i < list.size(); ++i) files.emplace_back(list[i].get<std::string>(), item_range(paths_key, i));
+      for (size_t i = 0; i < list.size(); ++i) files.push_back({list[i].get<std::string>(), item_range(paths_key, i), paths_key});
     } else if (const Json& dir = spec_.value(dir_key); dir.is_string()) {
       const auto found = scan_background_dir(dir.get<std::string>());
       if (!found) {
         diags_.report(Rule::AssetMissing, range_of(dir_key),
                       "background folder '" + dir.get<std::string>() + "' does not exist; fix the path",
-                      "/" + std::string(dir_key));
+                      pointer_of(dir_key));
         return;
       }
-      for (const std::string& f : *found) files.emplace_back(f, range_of(dir_key));
+      for (const std::string& f : *found) files.push_back({f, range_of(dir_key), dir_key});
     }
     if (files.empty()) {
-      if (const Json& one = spec_.value(file_key); one.is_string()) files.emplace_back(one.get<std::string>(), range_of(file_key));
+      if (const Json& one = spec_.value(file_key); one.is_string()) files.push_back({one.get<std::string>(), range_of(file_key), file_key});
     }
     if (files.empty()) {
       const Range at = range_of(g.enable_key);
       diags_.report(Rule::AssetEmpty, at,
                     "background mode is 'image' but no background images were found; set one of " +
                         std::string(paths_key) + ", " + dir_key + " or " + file_key,
-                    "/" + std::string(g.enable_key));
+                    pointer_of(g.enable_key));
       return;
     }
-    for (const auto& [file, at] : files)
-      if (auto f = hash_image(file, at, std::string(paths_key))) spec_.assets.backgrounds.push_back(*f);
+    for (const Source& src : files)
+      if (auto f = hash_image(src.file, src.at, src.key)) spec_.assets.backgrounds.push_back(*f);
   }
 
   void resolve_skins(const AssetGroupRef& g) {
-    std::vector<std::pair<std::string, Range>> dirs;
+    struct Source {
+      std::string dir;
+      Range at;
+      const char* key;
+    };
+    std::vector<Source> dirs;
     const Json& parent = spec_.value(g.sources[0]);
     const Json& list = spec_.value(g.sources[1]);
     const Json& single = spec_.value(g.sources[2]);
@@ -159,37 +174,37 @@ class AssetResolver {
         diags_.report(Rule::AssetMissing, range_of(g.sources[0]),
                       "sprite folder '" + parent.get<std::string>() +
                           "' does not exist (the original would load no sprites and draw nothing); fix the path",
-                      "/" + std::string(g.sources[0]));
+                      pointer_of(g.sources[0]));
         return;
       }
-      for (const std::string& d : *found) dirs.emplace_back(d, range_of(g.sources[0]));
+      for (const std::string& d : *found) dirs.push_back({d, range_of(g.sources[0]), g.sources[0]});
     } else if (list.is_array() && !list.empty()) {
-      for (size_t i = 0; i < list.size(); ++i) dirs.emplace_back(list[i].get<std::string>(), item_range(g.sources[1], i));
+      for (size_t i = 0; i < list.size(); ++i) dirs.push_back({list[i].get<std::string>(), item_range(g.sources[1], i), g.sources[1]});
     } else if (single.is_string()) {
-      dirs.emplace_back(single.get<std::string>(), range_of(g.sources[2]));
+      dirs.push_back({single.get<std::string>(), range_of(g.sources[2]), g.sources[2]});
     }
     if (dirs.empty()) {
       diags_.report(Rule::AssetNoSprites, range_of(g.enable_key),
                     "'" + std::string(g.enable_key) + "' is true but no sprites are given, so nothing is drawn; set " +
                         g.sources[0] + ", " + g.sources[1] + " or " + g.sources[2],
-                    "/" + std::string(g.enable_key));
+                    pointer_of(g.enable_key));
       return;
     }
     std::vector<AssetSet>& sets = *spec_.assets.sets(g.name);
-    for (const auto& [dir, at] : dirs) {
+    for (const auto& [dir, at, key] : dirs) {
       std::error_code ec;
       if (!fs::is_directory(dir, ec)) {
         diags_.report(Rule::AssetMissing, at, "sprite folder '" + dir + "' does not exist; fix the path",
-                      "/" + std::string(g.sources[1]));
+                      pointer_of(key));
         continue;
       }
       AssetSet set;
       set.dir = display_path(dir);
       for (const std::string& frame : scan_skin_frames(dir))
-        if (auto f = hash_image(frame, at, g.sources[1])) set.frames.push_back(*f);
+        if (auto f = hash_image(frame, at, key)) set.frames.push_back(*f);
       if (set.frames.empty()) {
         diags_.report(Rule::AssetEmpty, at, "sprite folder '" + dir + "' holds no PNG frames; add frames or remove it",
-                      "/" + std::string(g.sources[1]));
+                      pointer_of(key));
         continue;
       }
       sets.push_back(std::move(set));

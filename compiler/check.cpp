@@ -187,14 +187,16 @@ void report_unknown(const DocEntry& e, const std::string& section, const std::ve
   if (guess) d.fixits.push_back({e.key_range, *guess});
 }
 
-bool provided(const DocNode& v) { return !v.is_null() && !(v.is_seq() && v.items.empty()); }
+bool provided(const DocNode& v, bool empty_counts) {
+  return !v.is_null() && (empty_counts || !(v.is_seq() && v.items.empty()));
+}
 
 void check_section_rules(const SectionSchema& sec, const DocNode& body, const Schema& schema, DiagEngine& diags) {
   const std::string prefix = sec.name.empty() ? "" : sec.name + ".";
   for (const auto& group : sec.exclusive) {
     std::vector<const DocEntry*> given;
     for (const std::string& k : group)
-      if (const DocEntry* e = body.find(k); e && provided(e->value)) given.push_back(e);
+      if (const DocEntry* e = body.find(k); e && provided(e->value, sec.exclusive_counts_empty)) given.push_back(e);
     if (given.size() < 2) continue;
     Diagnostic& d = diags.report(Rule::SchemaConflict, given[1]->key_range,
                                  "'" + prefix + given[1]->key + "' conflicts with '" + prefix + given[0]->key +

@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "compiler/internal_error.h"
 #include "compiler/schema.h"
 
 #include "compiler/generated/spec_fields.h"
@@ -18,37 +19,34 @@ namespace {
 
 constexpr double kNoBound = std::numeric_limits<double>::infinity();
 
-/// One limit of the runtime's storage on a key: its number (or list length), minus another key's
-/// number when `minus` is set, must lie in [lo, hi].
-struct CapacityRule {
-  const char* path;
-  const char* minus;
+/// The runtime's storage bounds, by the id the schema's `x-kage-capacity` names.
+struct CapacityLimit {
+  const char* id;
   double lo;
   double hi;
-  const char* what;
 };
 
-// Key names appear here like in key_refs.h: the few keys whose storage limits lowering must name.
-const CapacityRule kCapacityRules[] = {
-    {"H", nullptr, 1, kNoBound, "observation height"},
-    {"W", nullptr, 1, kNoBound, "observation width"},
-    {"layout.length", nullptr, 1, kNoBound, "world width in pixels"},
-    {"layout.height_px", nullptr, 1, kNoBound, "world height in pixels"},
-    {"layout.ground_thickness", nullptr, 0, kNoBound, "ground band rows"},
-    {"layout.max_height", "layout.min_height", 0, 255,
-     "height walk range (one byte per layout segment)"},
-    {"npc.max_npc_count", nullptr, 0, kMaxNpcs, "world NPC slots"},
-    {"npc.max_sticky_count", nullptr, 0, kMaxSticky, "sticky NPC slots"},
-    {"distractors.count", nullptr, -kNoBound, kMaxDistractors, "distractor slots"},
-    {"npc.sticky_x_offsets", nullptr, 0, kMaxStickyOffsets, "entries"},
-    {"background.color_names", nullptr, 0, kMaxListEntries, "list entries"},
-    {"character.shape_types", nullptr, 0, kMaxListEntries, "list entries"},
-    {"character.shape_colors", nullptr, 0, kMaxListEntries, "list entries"},
-    {"layout.layout_colors", nullptr, 0, kMaxListEntries, "list entries"},
-    {"distractors.shape_types", nullptr, 0, kMaxListEntries, "list entries"},
-    {"distractors.shape_colors", nullptr, 0, kMaxListEntries, "list entries"},
-    {"filters.pop_filter_list", nullptr, 0, kMaxListEntries, "list entries"},
+const CapacityLimit kCapacityLimits[] = {
+    {"positive", 1, kNoBound},
+    {"non_negative", 0, kNoBound},
+    {"segment_byte", 0, 255},
+    {"npc_slots", 0, kMaxNpcs},
+    {"sticky_slots", 0, kMaxSticky},
+    {"distractor_slots", -kNoBound, kMaxDistractors},
+    {"sticky_offsets", 0, kMaxStickyOffsets},
+    {"list_entries", 0, kMaxListEntries},
 };
+
+const CapacityLimit* find_capacity_limit(const std::string& id) {
+  for (const CapacityLimit& l : kCapacityLimits)
+    if (id == l.id) return &l;
+  return nullptr;
+}
+
+const CapacityLimit& capacity_limit(const std::string& id) {
+  if (const CapacityLimit* l = find_capacity_limit(id)) return *l;
+  internal_error("schema names unknown capacity limit '" + id + "'", __FILE__, __LINE__);
+}
 
 /// A number, or the length of a list; nullopt for anything else (null, strings).
 std::optional<double> measure(const Json& v) {
@@ -275,31 +273,33 @@ std::string LowerResult::error_text() const {
 
 std::vector<CapacityError> capacity_errors(const Spec& spec) {
   std::vector<CapacityError> out;
-  for (const CapacityRule& r : kCapacityRules) {
-    if (spec.inert.count(r.path)) continue;
-    std::optional<double> v = measure(spec.value(r.path));
+  for (const KeySchema& k : config_schema().keys()) {
+    if (k.capacity_limit.empty() || spec.inert.count(k.path)) continue;
+    const CapacityLimit& r = capacity_limit(k.capacity_limit);
+    std::optional<double> v = measure(spec.value(k.path));
     if (!v) continue;
-    if (r.minus) {
-      const std::optional<double> m = measure(spec.value(r.minus));
+    if (!k.capacity_minus.empty()) {
+      const std::optional<double> m = measure(spec.value(k.capacity_minus));
       if (!m) continue;
       *v -= *m;
     }
     if (*v >= r.lo && *v <= r.hi) continue;
     const std::string lo = format_number(r.lo), hi = format_number(r.hi);
+    const std::string& what = k.capacity_what;
     std::string msg;
-    if (spec.value(r.path).is_array()) {
+    if (spec.value(k.path).is_array()) {
       msg = "has " + format_number(*v) + " entries, but the runtime holds at most " + hi + "; shorten the list";
-    } else if (r.minus) {
-      msg = "minus '" + std::string(r.minus) + "' is " + format_number(*v) + ", but the runtime holds a " + r.what +
-            " of " + lo + ".." + hi + "; bring the two closer";
+    } else if (!k.capacity_minus.empty()) {
+      msg = "minus '" + k.capacity_minus + "' is " + format_number(*v) + ", but the runtime holds a " + what + " of " +
+            lo + ".." + hi + "; bring the two closer";
     } else if (*v > r.hi) {
-      msg = "is " + format_number(*v) + ", but the runtime holds at most " + hi + " " + r.what + "; set it to " + hi +
+      msg = "is " + format_number(*v) + ", but the runtime holds at most " + hi + " " + what + "; set it to " + hi +
             " or less";
     } else {
-      msg = "is " + format_number(*v) + ", but the " + r.what + " must be at least " + lo + "; set it to " + lo +
+      msg = "is " + format_number(*v) + ", but the " + what + " must be at least " + lo + "; set it to " + lo +
             " or more";
     }
-    out.push_back(CapacityError{r.path, msg});
+    out.push_back(CapacityError{k.path, msg});
   }
   return out;
 }
@@ -336,13 +336,6 @@ void report_capacity(const ComposedConfig& config, const Spec& spec, DiagEngine&
   }
 }
 
-std::vector<std::string> capacity_rule_keys() {
-  std::vector<std::string> out;
-  for (const CapacityRule& r : kCapacityRules) {
-    out.push_back(r.path);
-    if (r.minus) out.push_back(r.minus);
-  }
-  return out;
-}
+bool capacity_limit_known(const std::string& id) { return find_capacity_limit(id) != nullptr; }
 
 }  // namespace kage

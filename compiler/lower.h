@@ -48,7 +48,7 @@ LowerResult lower_spec(const Spec& spec);
 /// (at the file itself when the key is inherited from a default).
 void report_capacity(const ComposedConfig& config, const Spec& spec, DiagEngine& diags);
 
-/// The dotted keys the capacity rules read (a test checks each one exists in the schema).
-std::vector<std::string> capacity_rule_keys();
+/// Whether lowering knows the storage bound an `x-kage-capacity` entry of the schema names.
+bool capacity_limit_known(const std::string& id);
 
 }  // namespace kage

@@ -175,6 +175,12 @@ class SchemaLoader {
       k.quirk_rule = prop.at("x-kage-quirk").at("rule").get<std::string>();
       k.quirk_message = prop.at("x-kage-quirk").at("message").get<std::string>();
     }
+    if (prop.contains("x-kage-capacity")) {
+      const Json& cap = prop.at("x-kage-capacity");
+      k.capacity_limit = cap.at("limit").get<std::string>();
+      k.capacity_what = cap.at("what").get<std::string>();
+      k.capacity_minus = cap.value("minus", "");
+    }
     sec.keys.push_back(out_.keys_.size());
     out_.keys_.push_back(std::move(k));
   }
@@ -185,6 +191,7 @@ class SchemaLoader {
     for (auto& [key, leaf] : prop.at("properties").items()) add_key(name, key, leaf, sec);
     if (prop.contains("x-kage-exclusive"))
       for (const Json& group : prop.at("x-kage-exclusive")) sec.exclusive.push_back(group.get<std::vector<std::string>>());
+    sec.exclusive_counts_empty = prop.value("x-kage-exclusive-counts-empty", false);
     if (prop.contains("x-kage-one-true"))
       for (const Json& pair : prop.at("x-kage-one-true"))
         sec.one_true.emplace_back(pair.at(0).get<std::string>(), pair.at(1).get<std::string>());

@@ -62,12 +62,15 @@ struct KeySchema {
   std::string asset_kind;  // file, dir, file_list, dir_list, skin_parent, image_dir
   Json inert_when;         // list of condition objects, or null
   std::string quirk_rule, quirk_message;
+  // A bound of the runtime's fixed storage (x-kage-capacity); empty limit when none.
+  std::string capacity_limit, capacity_what, capacity_minus;
 };
 
 struct SectionSchema {
   std::string name;  // "" for the root
   std::vector<size_t> keys;  // indices into Schema::keys
   std::vector<std::vector<std::string>> exclusive;
+  bool exclusive_counts_empty = false;  // an empty list counts as given (spec 2.3)
   std::vector<std::pair<std::string, std::string>> ordered;
   std::vector<std::pair<std::string, std::string>> one_true;  // if both are given, exactly one is true
 };

@@ -91,7 +91,8 @@ class Converter {
   Converter(const SourceManager& sm, FileId file, DiagEngine& diags)
       : sm_(sm), file_(file), diags_(diags), text_(sm.text(file)) {}
 
-  DocNode convert(const YAML::Node& n, uint32_t fallback_offset) {
+  // `pointer` is the JSON Pointer of `n` (for diagnostics).
+  DocNode convert(const YAML::Node& n, uint32_t fallback_offset, const std::string& pointer) {
     DocNode out;
     const uint32_t begin = offset_of(n, fallback_offset);
     out.range = Range{Loc{file_, begin}, begin};
@@ -116,7 +117,8 @@ class Converter {
         break;
       case YAML::NodeType::Sequence:
         out.kind = DocNode::Kind::Sequence;
-        for (const YAML::Node& item : n) out.items.push_back(convert(item, begin));
+        for (const YAML::Node& item : n)
+          out.items.push_back(convert(item, begin, pointer + "/" + std::to_string(out.items.size())));
         out.range.end = out.items.empty() ? begin + 1 : out.items.back().range.end;
         break;
       case YAML::NodeType::Map: {
@@ -127,12 +129,12 @@ class Converter {
           const uint32_t kb = offset_of(it->first, begin);
           e.key = it->first.IsScalar() ? it->first.Scalar() : std::string("?");
           e.key_range = Range{Loc{file_, kb}, kb + static_cast<uint32_t>(e.key.size())};
-          e.value = convert(it->second, e.key_range.end);
+          e.value = convert(it->second, e.key_range.end, pointer + "/" + e.key);
           if (e.value.is_null()) e.value.range = Range{Loc{file_, e.key_range.begin.offset}, e.key_range.end};
           auto [prev, inserted] = seen.emplace(e.key, e.key_range);
           if (!inserted) {
             Diagnostic& d = diags_.report(Rule::YamlDuplicateKey, e.key_range,
-                                          "duplicate key '" + e.key + "'; remove one of the two");
+                                          "duplicate key '" + e.key + "'; remove one of the two", pointer + "/" + e.key);
             d.notes.push_back({prev->second.begin, "first given here (the original would silently use the last one)"});
           }
           out.entries.push_back(std::move(e));
@@ -213,7 +215,7 @@ std::optional<DocNode> parse_yaml(const SourceManager& sources, FileId file, Dia
     return std::nullopt;
   }
   Converter conv(sources, file, diags);
-  DocNode doc = conv.convert(root, 0);
+  DocNode doc = conv.convert(root, 0, "");
   return doc;
 }
 

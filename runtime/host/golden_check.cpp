@@ -112,7 +112,7 @@ GoldenLine compare_image(const std::string& name, const uint8_t* got, const Imag
 
 std::vector<GoldenLine> check_physics(const std::string& name, const LatentParams& p, const json& file) {
   std::vector<GoldenLine> out;
-  if (file.value("episode_length", -1) != p.episode_length)
+  if (file.value("episode_length", -1) != p.episode_length)  // a field of the recording: not-a-config-key
     return {failure(name, "episode_length of the recording differs from the config's " + std::to_string(p.episode_length))};
   const std::vector<std::string> fields = file.at("fields").get<std::vector<std::string>>();
   std::map<std::string, FieldWorst> worst;

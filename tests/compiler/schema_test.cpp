@@ -158,8 +158,8 @@ TEST_CASE("asset keys and the groups of key_refs.h refer to each other", "[schem
   CHECK(sources_in_refs.size() == 12);
 }
 
-// Reports offenders; [!mayfail] keeps a finding in code under way from failing the whole run.
-TEST_CASE("no key name is spelt as a string literal in the C++ sources", "[schema][one-source-of-truth][!mayfail]") {
+// A line may mark a literal that is a field of another format (e.g. a recording) with `not-a-config-key`.
+TEST_CASE("no key name is spelt as a string literal in the C++ sources", "[schema][one-source-of-truth]") {
   std::set<std::string> names;
   for (const KeySchema& k : config_schema().keys()) {
     names.insert(k.path);
@@ -179,6 +179,7 @@ TEST_CASE("no key name is spelt as a string literal in the C++ sources", "[schem
       int n = 0;
       while (std::getline(in, line)) {
         ++n;
+        if (line.find("not-a-config-key") != std::string::npos) continue;
         const auto comment = line.find("//");
         const std::string code = comment == std::string::npos ? line : line.substr(0, comment);
         for (auto it = std::sregex_iterator(code.begin(), code.end(), literal); it != std::sregex_iterator(); ++it)
