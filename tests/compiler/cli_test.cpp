@@ -44,7 +44,7 @@ TEST_CASE("an unknown command suggests the closest one", "[cli]") {
   CHECK(far.err.find("did you mean") == std::string::npos);
 }
 
-TEST_CASE("--disable with an unknown rule is a usage error", "[cli]") {
+TEST_CASE("an unknown rule for --disable is a usage error", "[cli]") {
   const CliRun r = kagec({"lint", "--disable", "inert-settings", "tests/lint/no-diagnostics.yaml"});
   CHECK(r.code == 2);
   CHECK(r.err.find("unknown rule 'inert-settings' for --disable") != std::string::npos);
@@ -92,7 +92,7 @@ TEST_CASE("text diagnostics show the source line, a caret, fix-its and notes", "
   CHECK(r.err == expected);
 }
 
-TEST_CASE("--format json prints the frozen diagnostic format", "[cli][json]") {
+TEST_CASE("json format prints the frozen diagnostic fields", "[cli][json]") {
   const CliRun r = kagec({"lint", "--format", "json", "tests/lint/schema-unknown-key-json.yaml"});
   CHECK(r.code == 1);
   CHECK(r.err.empty());
