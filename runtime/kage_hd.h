@@ -14,6 +14,13 @@
 #define KAGE_HD inline
 #endif
 
+// Loop unrolling hint: honoured by nvcc and NVRTC, absent for host compilers (which warn on it).
+#if defined(__CUDACC__) || defined(__CUDACC_RTC__)
+#define KAGE_UNROLL _Pragma("unroll")
+#else
+#define KAGE_UNROLL
+#endif
+
 #if defined(__CUDACC_RTC__)
 // NVRTC has no libc headers; the fixed-width types come from the builtins.
 typedef unsigned char uint8_t;

@@ -30,10 +30,10 @@ KAGE_HD void threefry2x32(Key k, uint32_t c0, uint32_t c1, uint32_t& y0, uint32_
   const uint32_t r1[4] = {17, 29, 16, 24};
   uint32_t x0 = c0 + ks[0];
   uint32_t x1 = c1 + ks[1];
-#pragma unroll
+KAGE_UNROLL
   for (uint32_t j = 1; j <= 5; ++j) {
     const uint32_t* rs = (j & 1u) ? r0 : r1;
-#pragma unroll
+KAGE_UNROLL
     for (int i = 0; i < 4; ++i) {
       x0 += x1;
       x1 = rotl32(x1, rs[i]);
@@ -107,7 +107,7 @@ struct Words4 {
 
 KAGE_HD Words4 philox4x32(Key k, uint32_t c0, uint32_t c1, uint32_t c2 = 0u, uint32_t c3 = 0u) {
   uint32_t k0 = k.k0, k1 = k.k1;
-#pragma unroll
+KAGE_UNROLL
   for (int r = 0; r < 10; ++r) {
     const uint64_t p0 = static_cast<uint64_t>(0xD2511F53u) * c0;
     const uint64_t p1 = static_cast<uint64_t>(0xCD9E8D57u) * c2;
