@@ -90,7 +90,7 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
   }
   if (!render_supported(vp)) {
     *error = "DeviceBatch: frame size not supported on the GPU (W <= " + std::to_string(kMaxScreenWidth) +
-             "; with blur, sharpen or pixelate H * W <= " + std::to_string(kFramePassMaxThreads * kPixelsPerThread) + ")";
+             "; with blur, sharpen or pixelate H * W <= " + std::to_string(kFramePassMaxThreads * kFramePassPixelsPerThread) + ")";
     return std::nullopt;
   }
   DeviceBatch b;

@@ -124,6 +124,20 @@ struct FrameSetup {
   Preset episode_preset;
   FilterKeys keys;
   float jitter[9];
+  ScreenBox agent_box;  ///< outside it the agent leaves pixels unchanged
+  bool plain;           ///< every pixel outside agent_box is a function of solid() alone (register path)
+};
+
+/// The extremes of the solid spans of one 16-column group: a row outside [lo_min, hi_max) is empty in
+/// every column of the group and a row in [lo_max, hi_min) solid in every column.
+struct GroupSpan {
+  short lo_min, lo_max, hi_min, hi_max;
+};
+
+/// A layout mask that is the same everywhere: composes the two colours of a plain run.
+struct ConstSolid {
+  bool value;
+  __device__ __forceinline__ bool operator()(int32_t, int32_t) const { return value; }
 };
 
 /// The layout mask at screen row r and world column wc = c + cam through the block's column table;
@@ -139,6 +153,9 @@ struct SpanSolid {
   }
 };
 
+constexpr short kShortMax = 32767;
+constexpr short kShortMin = -32768;
+
 /// Shared memory of a rendering block besides the optional float frame.
 struct BlockShared {
   LatentState latent;
@@ -146,6 +163,7 @@ struct BlockShared {
   alignas(16) VisualState visual;
   alignas(16) uint8_t segments[kMaxLayoutBytes];
   ColumnSpan spans[kMaxScreenWidth];
+  GroupSpan groups[kMaxScreenWidth / kPixelsPerThread];
 };
 
 /// Copies `bytes` (a multiple of 4) between two 4-byte aligned buffers with the whole block.
@@ -177,55 +195,100 @@ __device__ __forceinline__ void pixel_stages(const VisualState& vs, const FrameS
 }
 
 /// The composited, filtered and lit pixel (r, c) of the register path.
-template <class Cfg>
-__device__ __forceinline__ void register_pixel(const AssetView& assets, const BlockShared& sh, const SpanSolid& solid,
+template <class Cfg, class SolidFn>
+__device__ __forceinline__ void register_pixel(const AssetView& assets, const BlockShared& sh, const SolidFn& solid,
                                                int32_t r, int32_t c, uint8_t* rgb) {
   const VisualParams& vp = ParamsOf<Cfg>::visual();
   compose_pixel(vp, assets, sh.setup.agent, solid, sh.visual, sh.setup.f, r, c, rgb);
   pixel_stages<Cfg>(sh.visual, sh.setup, r, c, rgb);
 }
 
-/// Shared words per thread of the register path's staging slot: 16 packed pixels plus one word of
-/// padding, so that the 32 threads of a warp hit 32 different banks.
-constexpr int32_t kStagingStride = kPixelsPerThread + 1;
+/// A pixel as one word: r | g << 8 | b << 16.
+__device__ __forceinline__ uint32_t pack_rgb(const uint8_t* rgb) {
+  return static_cast<uint32_t>(rgb[0]) | (static_cast<uint32_t>(rgb[1]) << 8) | (static_cast<uint32_t>(rgb[2]) << 16);
+}
 
-/// Register path: each thread renders runs of 16 pixels of one row, packs each pixel into a word of
-/// its staging slot, then repacks the run into three 16-byte stores (rows whose width is not a
-/// multiple of 16 are stored byte by byte).
+/// Four packed pixels (12 bytes) as three words: p0 p0 p0 p1 | p1 p1 p2 p2 | p2 p3 p3 p3.
+__device__ __forceinline__ void pack_quad(uint32_t a, uint32_t b, uint32_t c, uint32_t d, uint32_t* w) {
+  w[0] = a | (b << 24);
+  w[1] = (b >> 8) | (c << 16);
+  w[2] = (c >> 16) | (d << 8);
+}
+
+/// The pixel (r, c) of a plain run (outside the agent box) with the layout mask fixed to `solid`.
+template <class Cfg>
+__device__ __forceinline__ uint32_t plain_pixel(const AssetView& assets, const BlockShared& sh, bool solid, int32_t r,
+                                                int32_t c) {
+  uint8_t rgb[3];
+  register_pixel<Cfg>(assets, sh, ConstSolid{solid}, r, c, rgb);
+  return pack_rgb(rgb);
+}
+
+/// Register path: each thread renders runs of 16 pixels of one row and stores each as three 16-byte
+/// words (rows whose width is not a multiple of 16 are stored byte by byte). A plain run (nothing but
+/// the background and the layout, see compose_layout_only) composes one pixel per layout colour and
+/// selects per pixel through the column spans, or, when the group's span extremes show that the row
+/// is all solid or all empty, stores one colour; this takes simplest from ~75 instructions per pixel
+/// to a few. Other runs compose every pixel, four at a time into three words.
 template <class Cfg>
 __device__ __forceinline__ void render_register_path(const AssetView& assets, const BlockShared& sh,
-                                                     const SpanSolid& solid, uint32_t* staging, uint8_t* out) {
+                                                     const SpanSolid& solid, uint8_t* out) {
   const VisualParams& vp = ParamsOf<Cfg>::visual();
   if (register_path_vectorized(vp)) {
-    uint32_t* slot = staging + threadIdx.x * kStagingStride;
+    const FrameSetup& fs = sh.setup;
+    const bool plain = fs.plain;
+    const ScreenBox box = fs.agent_box;
     const int32_t runs_per_row = vp.W / kPixelsPerThread;
     for (int32_t run = static_cast<int32_t>(threadIdx.x); run < vp.H * runs_per_row;
          run += static_cast<int32_t>(blockDim.x)) {
       const int32_t r = run / runs_per_row;
-      const int32_t c0 = (run - r * runs_per_row) * kPixelsPerThread;
+      const int32_t g = run - r * runs_per_row;
+      const int32_t c0 = g * kPixelsPerThread;
+      uint8_t* dst = out + (r * vp.W + c0) * 3;
+      const bool agent_run = r >= box.y0 && r <= box.y1 && c0 <= box.x1 && c0 + kPixelsPerThread - 1 >= box.x0;
+      if (plain && !agent_run) {
+        const GroupSpan gs = sh.groups[g];
+        const int32_t rr = clampi(r, 0, solid.height_px - 1);
+        const bool none = rr < gs.lo_min || rr >= gs.hi_max;
+        const bool all = rr >= gs.lo_max && rr < gs.hi_min;
+        uint32_t w[12];
+        if (none || all) {
+          const uint32_t p = plain_pixel<Cfg>(assets, sh, all, r, c0);
+          pack_quad(p, p, p, p, w);
+#pragma unroll
+          for (int32_t q = 1; q < 4; ++q) w[3 * q] = w[0], w[3 * q + 1] = w[1], w[3 * q + 2] = w[2];
+        } else {
+          const uint32_t on = plain_pixel<Cfg>(assets, sh, true, r, c0);
+          const uint32_t off = plain_pixel<Cfg>(assets, sh, false, r, c0);
+          uint32_t px[kPixelsPerThread];
+#pragma unroll
+          for (int32_t j = 0; j < kPixelsPerThread; ++j) px[j] = solid(r, c0 + j + solid.cam) ? on : off;
+#pragma unroll
+          for (int32_t q = 0; q < 4; ++q) pack_quad(px[4 * q], px[4 * q + 1], px[4 * q + 2], px[4 * q + 3], w + 3 * q);
+        }
+        uint4* d4 = reinterpret_cast<uint4*>(dst);
+        d4[0] = make_uint4(w[0], w[1], w[2], w[3]);
+        d4[1] = make_uint4(w[4], w[5], w[6], w[7]);
+        d4[2] = make_uint4(w[8], w[9], w[10], w[11]);
+      } else {
+        // Four pixels at a time (three 4-byte stores): the whole chain is inlined four times, not 16.
 #pragma unroll 1
-      for (int32_t j = 0; j < kPixelsPerThread; ++j) {
-        uint8_t rgb[3];
-        register_pixel<Cfg>(assets, sh, solid, r, c0 + j, rgb);
-        slot[j] = static_cast<uint32_t>(rgb[0]) | (static_cast<uint32_t>(rgb[1]) << 8) |
-                  (static_cast<uint32_t>(rgb[2]) << 16);
-      }
-      uint32_t px[kPixelsPerThread];
+        for (int32_t q = 0; q < 4; ++q) {
+          uint32_t px[4];
 #pragma unroll
-      for (int32_t j = 0; j < kPixelsPerThread; ++j) px[j] = slot[j];
-      // Four pixels (12 bytes) fill three words: p0 p0 p0 p1 | p1 p1 p2 p2 | p2 p3 p3 p3.
-      uint32_t w[12];
-#pragma unroll
-      for (int32_t q = 0; q < 4; ++q) {
-        const uint32_t a = px[4 * q], b = px[4 * q + 1], c = px[4 * q + 2], d = px[4 * q + 3];
-        w[3 * q] = a | (b << 24);
-        w[3 * q + 1] = (b >> 8) | (c << 16);
-        w[3 * q + 2] = (c >> 16) | (d << 8);
+          for (int32_t k = 0; k < 4; ++k) {
+            uint8_t rgb[3];
+            register_pixel<Cfg>(assets, sh, solid, r, c0 + 4 * q + k, rgb);
+            px[k] = pack_rgb(rgb);
+          }
+          uint32_t w[3];
+          pack_quad(px[0], px[1], px[2], px[3], w);
+          uint32_t* d = reinterpret_cast<uint32_t*>(dst + 12 * q);
+          d[0] = w[0];
+          d[1] = w[1];
+          d[2] = w[2];
+        }
       }
-      uint4* dst = reinterpret_cast<uint4*>(out + (r * vp.W + c0) * 3);
-      dst[0] = make_uint4(w[0], w[1], w[2], w[3]);
-      dst[1] = make_uint4(w[4], w[5], w[6], w[7]);
-      dst[2] = make_uint4(w[8], w[9], w[10], w[11]);
     }
   } else {
     for (int32_t i = static_cast<int32_t>(threadIdx.x); i < vp.H * vp.W; i += static_cast<int32_t>(blockDim.x)) {
@@ -253,6 +316,45 @@ struct FramePass {
     return pixel(k) < vp.H * vp.W;
   }
 
+  /// Whether run_banded applies: the block covers whole rows (pixel k of every thread lies in rows
+  /// [kB, kB + B), B = blockDim / W >= 1), so a pass reading one row up and down can go band by band.
+  __device__ __forceinline__ static bool banded() {
+    const VisualParams& vp = ParamsOf<Cfg>::visual();
+    return static_cast<int32_t>(blockDim.x) % vp.W == 0;
+  }
+
+  /// As run for passes that read at most one row above and below (blur, sharpen): band k is read while
+  /// band k - 1 still holds its old values, and band k - 1 is written after the barrier that follows
+  /// band k's reads (band k + 1 reads nothing of band k - 1). Each thread holds 2 x 3 values instead of
+  /// 16 x 3, which is what made the 1024-thread frame-pass kernel spill.
+  template <class Sample>
+  __device__ __forceinline__ void run_banded(const Sample& sample) const {
+    const VisualParams& vp = ParamsOf<Cfg>::visual();
+    __syncthreads();
+    float prev[3] = {0.0f, 0.0f, 0.0f};
+#pragma unroll 1
+    for (int32_t k = 0; k < kFramePassPixelsPerThread; ++k) {
+      float cur[3];
+      const bool own = owned(k);
+      if (own) {
+        const int32_t i = pixel(k);
+#pragma unroll
+        for (int32_t ch = 0; ch < 3; ++ch) cur[ch] = sample(i / vp.W, i % vp.W, ch);
+      }
+      __syncthreads();
+      if (k > 0 && owned(k - 1))
+#pragma unroll
+        for (int32_t ch = 0; ch < 3; ++ch) frame[pixel(k - 1) * 3 + ch] = prev[ch];
+      if (own)
+#pragma unroll
+        for (int32_t ch = 0; ch < 3; ++ch) prev[ch] = cur[ch];
+    }
+    if (owned(kFramePassPixelsPerThread - 1))
+#pragma unroll
+      for (int32_t ch = 0; ch < 3; ++ch) frame[pixel(kFramePassPixelsPerThread - 1) * 3 + ch] = prev[ch];
+    __syncthreads();
+  }
+
   /// Runs sample(frame, r, c, ch) for every owned value, then replaces the frame with the results.
   template <class Sample>
   __device__ __forceinline__ void run(const Sample& sample) const {
@@ -262,17 +364,19 @@ struct FramePass {
     // owned by other warps were read half-updated: 0.3-0.5 % of the hardest frames' values differed
     // from the CPU reference, up to 109 codes).
     __syncthreads();
-    float nv[kPixelsPerThread][3];
-#pragma unroll
-    for (int32_t k = 0; k < kPixelsPerThread; ++k)
+    // Not unrolled: nv lives in local memory instead of taking 96 registers from every other stage
+    // (only the fallback of pixelate uses this).
+    float nv[kFramePassPixelsPerThread][3];
+#pragma unroll 1
+    for (int32_t k = 0; k < kFramePassPixelsPerThread; ++k)
       if (owned(k)) {
         const int32_t i = pixel(k);
 #pragma unroll
         for (int32_t ch = 0; ch < 3; ++ch) nv[k][ch] = sample(i / vp.W, i % vp.W, ch);
       }
     __syncthreads();
-#pragma unroll
-    for (int32_t k = 0; k < kPixelsPerThread; ++k)
+#pragma unroll 1
+    for (int32_t k = 0; k < kFramePassPixelsPerThread; ++k)
       if (owned(k))
 #pragma unroll
         for (int32_t ch = 0; ch < 3; ++ch) frame[pixel(k) * 3 + ch] = nv[k][ch];
@@ -284,7 +388,9 @@ struct FramePass {
     const VisualParams& vp = ParamsOf<Cfg>::visual();
     const float b = blur_weight(sigma);
     const float* f = frame;
-    run([&](int32_t r, int32_t c, int32_t ch) { return blur_at(f, vp.H, vp.W, r, c, ch, b); });
+    const auto sample = [&](int32_t r, int32_t c, int32_t ch) { return blur_at(f, vp.H, vp.W, r, c, ch, b); };
+    if (banded()) run_banded(sample);
+    else run(sample);
   }
 
   /// Sharpen (7.1 step 9): clip(F + amount*(F - blur1(F)), 0, 255), as sharpen_pass.
@@ -292,16 +398,37 @@ struct FramePass {
     const VisualParams& vp = ParamsOf<Cfg>::visual();
     const float b = blur_weight(1.0f);
     const float* f = frame;
-    run([&](int32_t r, int32_t c, int32_t ch) {
+    const auto sample = [&](int32_t r, int32_t c, int32_t ch) {
       const float src = f[(r * vp.W + c) * 3 + ch];
       return clampf(src + amount * (src - blur_at(f, vp.H, vp.W, r, c, ch, b)), 0.0f, 255.0f);
-    });
+    };
+    if (banded()) run_banded(sample);
+    else run(sample);
   }
 
   /// Pixelate (7.1 step 10): F[pix(r)][pix(c)], as pixelate_pass.
   __device__ __forceinline__ void pixelate(int32_t factor) const {
     const VisualParams& vp = ParamsOf<Cfg>::visual();
     const float* f = frame;
+    // When every source pixel is its own source (pix(pix(i)) = pix(i) for the owned rows and columns),
+    // no source changes value, so each pixel can be read and written in place in one sweep.
+    bool fixed = true;
+    for (int32_t k = 0; k < kFramePassPixelsPerThread; ++k)
+      if (owned(k)) {
+        const int32_t i = pixel(k), r = pixelate_index(i / vp.W, vp.H, factor), c = pixelate_index(i % vp.W, vp.W, factor);
+        fixed = fixed && pixelate_index(r, vp.H, factor) == r && pixelate_index(c, vp.W, factor) == c;
+      }
+    if (__syncthreads_and(fixed)) {
+#pragma unroll 1
+      for (int32_t k = 0; k < kFramePassPixelsPerThread; ++k)
+        if (owned(k)) {
+          const int32_t i = pixel(k);
+          const int32_t src = pixelate_index(i / vp.W, vp.H, factor) * vp.W + pixelate_index(i % vp.W, vp.W, factor);
+          for (int32_t ch = 0; ch < 3; ++ch) frame[i * 3 + ch] = f[src * 3 + ch];
+        }
+      __syncthreads();
+      return;
+    }
     run([&](int32_t r, int32_t c, int32_t ch) {
       return f[(pixelate_index(r, vp.H, factor) * vp.W + pixelate_index(c, vp.W, factor)) * 3 + ch];
     });
@@ -355,9 +482,9 @@ __device__ __forceinline__ void render_frame_pass_path(const AssetView& assets, 
     for (int32_t i = first; i < n; i += stride) chain_tail_pixel(vp, fs.keys, i / vp.W, i % vp.W, frame + i * 3);
   }
   // Truncate and light the owned pixels into registers, then stage the bytes over the frame.
-  uint32_t px[kPixelsPerThread];
+  uint32_t px[kFramePassPixelsPerThread];
 #pragma unroll
-  for (int32_t k = 0; k < kPixelsPerThread; ++k)
+  for (int32_t k = 0; k < kFramePassPixelsPerThread; ++k)
     if (pass.owned(k)) {
       const int32_t i = pass.pixel(k);
       uint8_t rgb[3];
@@ -369,7 +496,7 @@ __device__ __forceinline__ void render_frame_pass_path(const AssetView& assets, 
   __syncthreads();
   uint8_t* staged = reinterpret_cast<uint8_t*>(frame);
 #pragma unroll
-  for (int32_t k = 0; k < kPixelsPerThread; ++k)
+  for (int32_t k = 0; k < kFramePassPixelsPerThread; ++k)
     if (pass.owned(k))
       for (int32_t ch = 0; ch < 3; ++ch) staged[pass.pixel(k) * 3 + ch] = static_cast<uint8_t>(px[k] >> (8 * ch));
   __syncthreads();
@@ -394,14 +521,23 @@ __device__ __forceinline__ void render_block(const DeviceEnvs& e, int32_t env, B
   if (threadIdx.x == 0) {
     FrameSetup& fs = sh.setup;
     fs.agent = AgentView{sh.latent.x, sh.latent.y, sh.latent.camera_x};
-    fs.f = frame_constants(fs.agent, sh.visual);
+    agent_frame_constants(vp, fs.agent, sh.visual, fs.f);
     fs.episode_preset = episode_preset(vp, sh.visual);
+    fs.agent_box = agent_box(vp, e.assets, sh.visual, fs.f);
+    fs.plain = !needs_frame_passes(vp) && compose_layout_only(vp, e.assets) && fs.episode_preset == Preset::kNone &&
+               filters_identity(vp) && !vp.point_light_enabled;
     for (int32_t i = 0; i < 9; ++i) fs.jitter[i] = (i % 4 == 0) ? 1.0f : 0.0f;
     if (vp.color_jitter_std > 0.0f || vp.gaussian_noise_std > 0.0f || vp.poisson_noise_scale > 0.0f) {
       fs.keys = filter_keys(device_episode_key(e, env, sh.latent.episode), static_cast<uint32_t>(sh.latent.t));
       if (vp.color_jitter_std > 0.0f) jitter_matrix(fs.keys.jitter, vp.color_jitter_std, fs.jitter);
     }
   }
+  // The distractors' per-frame shape values (up to 20 sin/cos each) on the second warp, beside thread 0.
+  const int32_t dist_first = blockDim.x > 32 ? 32 : 0;
+  if (static_cast<int32_t>(threadIdx.x) >= dist_first)
+    for (int32_t i = static_cast<int32_t>(threadIdx.x) - dist_first; i < distractor_slots(vp);
+         i += static_cast<int32_t>(blockDim.x) - dist_first)
+      sh.setup.f.dist[i] = distractor_frame(vp, sh.visual, i);
   __syncthreads();
   const int32_t cam = sh.setup.f.cam;
   const LayoutView layout{sh.segments};
@@ -410,11 +546,25 @@ __device__ __forceinline__ void render_block(const DeviceEnvs& e, int32_t env, B
     sh.spans[c] = ColumnSpan{static_cast<short>(s.lo), static_cast<short>(s.hi)};
   }
   __syncthreads();
+  if (sh.setup.plain) {
+    for (int32_t g = static_cast<int32_t>(threadIdx.x); g < vp.W / kPixelsPerThread; g += static_cast<int32_t>(blockDim.x)) {
+      GroupSpan gs{kShortMax, kShortMin, kShortMax, kShortMin};
+      for (int32_t j = 0; j < kPixelsPerThread; ++j) {
+        const ColumnSpan s = sh.spans[g * kPixelsPerThread + j];
+        gs.lo_min = s.lo < gs.lo_min ? s.lo : gs.lo_min;
+        gs.lo_max = s.lo > gs.lo_max ? s.lo : gs.lo_max;
+        gs.hi_min = s.hi < gs.hi_min ? s.hi : gs.hi_min;
+        gs.hi_max = s.hi > gs.hi_max ? s.hi : gs.hi_max;
+      }
+      sh.groups[g] = gs;
+    }
+    __syncthreads();
+  }
   const SpanSolid solid{sh.spans, cam, lp.height_px};
   if (needs_frame_passes(vp)) {
     render_frame_pass_path<Cfg>(e.assets, sh, solid, frame, out);
   } else {
-    render_register_path<Cfg>(e.assets, sh, solid, reinterpret_cast<uint32_t*>(frame), out);
+    render_register_path<Cfg>(e.assets, sh, solid, out);
   }
 }
 
@@ -441,6 +591,24 @@ __device__ __forceinline__ uint8_t* frame_of(const DeviceEnvs& e, int32_t env) {
   const VisualParams& vp = ParamsOf<Cfg>::visual();
   return e.obs + static_cast<int64_t>(env) * vp.H * vp.W * 3;
 }
+
+/// Launch bounds of the rendering kernels: at most a frame-pass block; a config that certainly takes
+/// the register path (no neighbourhood filter, no preset: tested on constants, as needs_frame_passes is
+/// not constexpr) asks for two such blocks' worth, i.e. four 256-thread blocks per SM (64 registers).
+template <class Cfg>
+struct RenderBounds {
+  static constexpr VisualParams kVisual = Cfg::visual();
+  static constexpr bool kMayPass = kVisual.blur_sigma > 0.0f || kVisual.sharpen_amount > 0.0f ||
+                                   kVisual.pixelate_factor > 1 || kVisual.pop_filter != Preset::kNone ||
+                                   kVisual.pop_filter_count > 0;
+  static constexpr int32_t kThreads = kFramePassMaxThreads;
+  static constexpr int32_t kMinBlocks = kMayPass ? 1 : 2;
+};
+template <>
+struct RenderBounds<DynamicCfg> {
+  static constexpr int32_t kThreads = kFramePassMaxThreads;
+  static constexpr int32_t kMinBlocks = 1;
+};
 
 // ---- kernel bodies (the extern "C" entry points are emitted by KAGE_INSTANTIATE_KERNELS) ----
 
@@ -505,12 +673,14 @@ __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n,
 #define KAGE_INSTANTIATE_KERNELS(CFG)                                                                     \
   extern "C" __global__ void kage_reset(const kage::DeviceEnvs e) { kage::reset_body<CFG>(e); }           \
   extern "C" __global__ void kage_step_only(const kage::DeviceEnvs e) { kage::step_only_body<CFG>(e); }   \
-  extern "C" __global__ void __launch_bounds__(1024, 1) kage_step_render(const kage::DeviceEnvs e) {         \
+  extern "C" __global__ void __launch_bounds__(kage::RenderBounds<CFG>::kThreads,                          \
+                                               kage::RenderBounds<CFG>::kMinBlocks) kage_step_render(const kage::DeviceEnvs e) {         \
     __shared__ kage::BlockShared sh;                                                                      \
     extern __shared__ float4 kage_frame[];                                                                \
     kage::step_render_body<CFG>(e, sh, reinterpret_cast<float*>(kage_frame));                             \
   }                                                                                                       \
-  extern "C" __global__ void __launch_bounds__(1024, 1) kage_render(const kage::DeviceEnvs e) {              \
+  extern "C" __global__ void __launch_bounds__(kage::RenderBounds<CFG>::kThreads,                          \
+                                               kage::RenderBounds<CFG>::kMinBlocks) kage_render(const kage::DeviceEnvs e) {              \
     __shared__ kage::BlockShared sh;                                                                      \
     extern __shared__ float4 kage_frame[];                                                                \
     kage::render_body<CFG>(e, sh, reinterpret_cast<float*>(kage_frame));                                  \

@@ -19,8 +19,12 @@ constexpr int32_t kMaxScreenWidth = 1024;
 constexpr int32_t kPixelsPerThread = 16;
 /// Threads of a register-path block (one frame per block).
 constexpr int32_t kRegisterPathThreads = 256;
-/// Largest block of the frame-pass path; every pixel of the frame belongs to one of its threads.
-constexpr int32_t kFramePassMaxThreads = 1024;
+/// Pixels per thread of the frame-pass path (strided), and its largest block: every pixel of the frame
+/// belongs to one of its threads. 512 threads of 32 pixels rather than 1024 of 16: the register cap
+/// of a 512-thread block is 128 instead of 64 (the 1024-thread kernel spilled 2.2 KB per thread), and
+/// the banded passes keep only two pixels' results in registers whatever the pixel count.
+constexpr int32_t kFramePassPixelsPerThread = 32;
+constexpr int32_t kFramePassMaxThreads = 512;
 
 /// Whether any frame pass can run: a sharpening preset in pop_filter_list or pop_filter, blur,
 /// sharpen or pixelate (spec 7.1 steps A, 8-10).
@@ -38,15 +42,14 @@ KAGE_HD bool register_path_vectorized(const VisualParams& p) { return p.W % kPix
 /// Threads per rendering block.
 KAGE_HD int32_t render_threads(const VisualParams& p) {
   if (!needs_frame_passes(p)) return kRegisterPathThreads;
-  const int32_t per = (p.H * p.W + kPixelsPerThread - 1) / kPixelsPerThread;
+  const int32_t per = (p.H * p.W + kFramePassPixelsPerThread - 1) / kFramePassPixelsPerThread;
   return (per + 31) / 32 * 32;
 }
 
-/// Dynamic shared memory of a rendering block: the float32 frame of the frame-pass path, or the
-/// register path's staging slots (16 packed pixels + 1 padding word per thread).
+/// Dynamic shared memory of a rendering block: the float32 frame of the frame-pass path; the register
+/// path packs its pixels in registers and needs none (so more of its blocks fit on an SM).
 KAGE_HD int32_t render_dynamic_smem_bytes(const VisualParams& p) {
-  return needs_frame_passes(p) ? p.H * p.W * 3 * static_cast<int32_t>(sizeof(float))
-                               : kRegisterPathThreads * (kPixelsPerThread + 1) * static_cast<int32_t>(sizeof(uint32_t));
+  return needs_frame_passes(p) ? p.H * p.W * 3 * static_cast<int32_t>(sizeof(float)) : 0;
 }
 
 /// Whether the GPU kernels support this frame size: the frame-pass path holds one frame per block.

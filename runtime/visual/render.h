@@ -23,7 +23,7 @@ KAGE_HD int32_t render_scratch_floats(const VisualParams& p) { return 2 * p.H * 
 template <class SolidFn>
 KAGE_HD void render_frame(const VisualParams& p, const AssetView& assets, const AgentView& agent, const SolidFn& solid,
                           const VisualState& s, Key episode, uint32_t t, uint8_t* out, float* scratch) {
-  const FrameConstants f = frame_constants(agent, s);
+  const FrameConstants f = frame_constants(p, agent, s);
   for (int32_t r = 0; r < p.H; ++r) {
     for (int32_t c = 0; c < p.W; ++c) compose_pixel(p, assets, agent, solid, s, f, r, c, out + (r * p.W + c) * 3);
   }

@@ -39,14 +39,36 @@ KAGE_HD int32_t polygon_vertices(ShapeType type, float ox, float oy, float radiu
   return n;
 }
 
-/// Polygon-type test of pixel (c, r) against a shape centred on pixel (cx, cy), using the original's
-/// half-pixel centres so that edge pixels match (spec 6.6 note).
-KAGE_HD bool inside_polygon_shape(ShapeType type, int32_t cx, int32_t cy, float radius, float a, int32_t c,
-                                  int32_t r) {
-  float vx[10], vy[10];
-  const int32_t n = polygon_vertices(type, static_cast<float>(cx) + 0.5f, static_cast<float>(cy) + 0.5f,
-                                     radius, a, vx, vy);
-  return inside_polygon(vx, vy, n, static_cast<float>(c) + 0.5f, static_cast<float>(r) + 0.5f);
+/// Whether a shape type is drawn as a polygon (triangle, hexagon, star).
+KAGE_HD bool polygon_type(ShapeType type) {
+  return type == ShapeType::kTriangle || type == ShapeType::kPolygon || type == ShapeType::kStar;
+}
+
+/// The per-frame values of one drawn shape: cos and sin of its angle and, for polygon types, its
+/// vertices around the original's half-pixel centre (spec 6.6 note). They depend only on the shape's
+/// centre, radius and angle, so they are computed once per frame instead of once per pixel (a star
+/// costs 20 sin/cos); the per-pixel tests below read them, so the arithmetic is unchanged.
+struct ShapeFrame {
+  float cos_a;
+  float sin_a;
+  int32_t n;  ///< polygon vertices (0 for the other types)
+  float vx[10];
+  float vy[10];
+};
+
+KAGE_HD ShapeFrame shape_frame(ShapeType type, int32_t cx, int32_t cy, float radius, float a) {
+  ShapeFrame f{};
+  f.cos_a = cos(a);
+  f.sin_a = sin(a);
+  f.n = polygon_type(type) ? polygon_vertices(type, static_cast<float>(cx) + 0.5f, static_cast<float>(cy) + 0.5f,
+                                              radius, a, f.vx, f.vy)
+                           : 0;
+  return f;
+}
+
+/// Polygon-type test of pixel (c, r) against the shape's vertices, at the half-pixel centre.
+KAGE_HD bool inside_polygon_shape(const ShapeFrame& sf, int32_t c, int32_t r) {
+  return inside_polygon(sf.vx, sf.vy, sf.n, static_cast<float>(c) + 0.5f, static_cast<float>(r) + 0.5f);
 }
 
 /// Rotation of an offset by angle a (cos_a, sin_a precomputed): xr = dx cos - dy sin, yr = dx sin + dy cos.
@@ -59,13 +81,13 @@ KAGE_HD Rotated rotate(float dx, float dy, float cos_a, float sin_a) {
 }
 
 /// Whether pixel (c, r) is inside the agent shape centred at (cx, cy) (spec 6.6).
-/// a is the angle in radians; w, h the character size.
-KAGE_HD bool inside_agent_shape(ShapeType type, int32_t cx, int32_t cy, int32_t w, int32_t h, float a,
-                                float cos_a, float sin_a, int32_t c, int32_t r) {
+/// w, h the character size; sf = shape_frame(type, cx, cy, 0.5 min(w, h), angle in radians).
+KAGE_HD bool inside_agent_shape(ShapeType type, int32_t cx, int32_t cy, int32_t w, int32_t h, const ShapeFrame& sf,
+                                int32_t c, int32_t r) {
   const float R = 0.5f * static_cast<float>(mini(w, h));
   const float dx = static_cast<float>(c - cx);
   const float dy = static_cast<float>(r - cy);
-  const Rotated q = rotate(dx, dy, cos_a, sin_a);
+  const Rotated q = rotate(dx, dy, sf.cos_a, sf.sin_a);
   const float t_half = maxf(1.0f, R / 4.0f) / 2.0f;
   switch (type) {
     case ShapeType::kSquare:
@@ -85,19 +107,19 @@ KAGE_HD bool inside_agent_shape(ShapeType type, int32_t cx, int32_t cy, int32_t 
     case ShapeType::kTriangle:
     case ShapeType::kPolygon:
     case ShapeType::kStar:
-      return inside_polygon_shape(type, cx, cy, R, a, c, r);
+      return inside_polygon_shape(sf, c, r);
     default:
       return dx * dx + dy * dy <= R * R;
   }
 }
 
-/// Whether pixel (c, r) is inside a distractor of size s centred at (cx, cy) with angle a in radians
-/// (spec 9.4; the 32 x 32 window is the caller's).
-KAGE_HD bool inside_distractor(ShapeType type, int32_t cx, int32_t cy, float s, float a, float cos_a,
-                               float sin_a, int32_t c, int32_t r) {
+/// Whether pixel (c, r) is inside a distractor of size s centred at (cx, cy) (spec 9.4; the 32 x 32
+/// window is the caller's); sf = shape_frame(type, cx, cy, s / 2, angle used as radians).
+KAGE_HD bool inside_distractor(ShapeType type, int32_t cx, int32_t cy, float s, const ShapeFrame& sf, int32_t c,
+                               int32_t r) {
   const float dx = static_cast<float>(c - cx);
   const float dy = static_cast<float>(r - cy);
-  const Rotated q = rotate(dx, dy, cos_a, sin_a);
+  const Rotated q = rotate(dx, dy, sf.cos_a, sf.sin_a);
   const float half = s / 2.0f;
   const float ht = 0.5f * maxf(1.0f, s / 8.0f);
   switch (type) {
@@ -117,7 +139,7 @@ KAGE_HD bool inside_distractor(ShapeType type, int32_t cx, int32_t cy, float s, 
     case ShapeType::kTriangle:
     case ShapeType::kPolygon:
     case ShapeType::kStar:
-      return inside_polygon_shape(type, cx, cy, half, a, c, r);
+      return inside_polygon_shape(sf, c, r);
     default:
       return dx * dx + dy * dy <= half * half;
   }
