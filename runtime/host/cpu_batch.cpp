@@ -24,13 +24,7 @@ CpuBatch::CpuBatch(const LatentParams& p, int32_t num_envs, const CpuBatchOption
       states_(num_envs, LatentState{}),
       segments_(stride_ * num_envs, 0),
       obs_(obs_stride_ * num_envs, 0) {
-  const size_t n = static_cast<size_t>(num_envs);
-  for (auto* v : {&info_.reward, &info_.x, &info_.y, &info_.vx, &info_.vy, &info_.passed_distance, &info_.progress,
-                  &info_.episode_return}) {
-    v->assign(n, 0.0f);
-  }
-  for (auto* v : {&info_.terminated, &info_.truncated, &info_.success, &info_.success_once}) v->assign(n, 0);
-  for (auto* v : {&info_.jump_count, &info_.timestep}) v->assign(n, 0);
+  info_.resize(static_cast<size_t>(num_envs));
 }
 
 Key CpuBatch::episode_key(int32_t env) const { return fold(seed_key(seeds_[env]), states_[env].episode); }
@@ -54,31 +48,13 @@ void CpuBatch::reset_env(int32_t env, uint32_t episode) {
   if (hook_.on_reset) hook_.on_reset(hook_.user, env, key, params_, LayoutView{segments}, states_[env], obs(env));
 }
 
-void CpuBatch::record_info(int32_t env, const StepOutcome& o) {
-  const LatentState& s = states_[env];
-  info_.reward[env] = o.reward;
-  info_.terminated[env] = o.terminated;
-  info_.truncated[env] = o.truncated;
-  info_.x[env] = s.x;
-  info_.y[env] = s.y;
-  info_.vx[env] = s.vx;
-  info_.vy[env] = s.vy;
-  info_.passed_distance[env] = o.passed_distance;
-  info_.progress[env] = o.progress;
-  info_.success[env] = o.success;
-  info_.success_once[env] = s.success_once;
-  info_.episode_return[env] = s.episode_return;
-  info_.jump_count[env] = s.jump_count;
-  info_.timestep[env] = s.t;
-}
-
 void CpuBatch::reset(const uint64_t* seeds) {
   std::copy(seeds, seeds + num_envs_, seeds_.begin());
   parallel_for([&](int32_t first, int32_t last) {
     for (int32_t env = first; env < last; ++env) {
       reset_env(env, 0);
       // A fresh episode reports zero reward and metrics at its spawn point.
-      record_info(env, StepOutcome{});
+      info_.record(env, states_[env], StepOutcome{});
     }
   });
 }
@@ -88,7 +64,7 @@ void CpuBatch::step(const int32_t* actions) {
     for (int32_t env = first; env < last; ++env) {
       const LayoutView layout = this->layout(env);
       const StepOutcome o = latent_step(params_, layout, states_[env], actions[env]);
-      record_info(env, o);
+      info_.record(env, states_[env], o);
       if (options_.autoreset && (o.terminated || o.truncated)) {
         if (hook_.on_final) hook_.on_final(hook_.user, env, episode_key(env), params_, layout, states_[env]);
         reset_env(env, states_[env].episode + 1);

@@ -51,6 +51,32 @@ struct BatchInfo {
   std::vector<float> episode_return;  ///< info "return"
   std::vector<int32_t> jump_count;
   std::vector<int32_t> timestep;      ///< info "timestep" = t
+
+  /// Sizes every column for n environments, zeroed.
+  void resize(size_t n) {
+    for (auto* v : {&reward, &x, &y, &vx, &vy, &passed_distance, &progress, &episode_return}) v->assign(n, 0.0f);
+    for (auto* v : {&terminated, &truncated, &success, &success_once}) v->assign(n, 0);
+    for (auto* v : {&jump_count, &timestep}) v->assign(n, 0);
+  }
+
+  /// Writes environment env's row from its state after a step (or a reset, with a zero outcome).
+  /// Inline: generated host libraries (kernels_host.so) use it without linking the runtime.
+  void record(int32_t env, const LatentState& s, const StepOutcome& o) {
+    reward[env] = o.reward;
+    terminated[env] = o.terminated;
+    truncated[env] = o.truncated;
+    x[env] = s.x;
+    y[env] = s.y;
+    vx[env] = s.vx;
+    vy[env] = s.vy;
+    passed_distance[env] = o.passed_distance;
+    progress[env] = o.progress;
+    success[env] = o.success;
+    success_once[env] = s.success_once;
+    episode_return[env] = s.episode_return;
+    jump_count[env] = s.jump_count;
+    timestep[env] = s.t;
+  }
 };
 
 /// N environments of one latent configuration. Episode e of the environment given seed s uses the key
@@ -88,7 +114,6 @@ class CpuBatch {
   template <class Fn>
   void parallel_for(const Fn& fn);
   void reset_env(int32_t env, uint32_t episode);
-  void record_info(int32_t env, const StepOutcome& o);
   uint8_t* obs(int32_t env) { return obs_.data() + static_cast<size_t>(env) * obs_stride_; }
 
   LatentParams params_;

@@ -28,11 +28,7 @@ class SpecializedCpuBatch {
     obs_.assign(n * frame_, 0);
     final_obs_.assign(n * frame_, 0);
     done_.assign(n, 0);
-    for (auto* v : {&info_.reward, &info_.x, &info_.y, &info_.vx, &info_.vy, &info_.passed_distance, &info_.progress,
-                    &info_.episode_return})
-      v->assign(n, 0.0f);
-    for (auto* v : {&info_.terminated, &info_.truncated, &info_.success, &info_.success_once}) v->assign(n, 0);
-    for (auto* v : {&info_.jump_count, &info_.timestep}) v->assign(n, 0);
+    info_.resize(n);
   }
 
   /// Starts episode 0 of every environment (`seeds`: size() entries) and renders its first frame.
@@ -82,23 +78,7 @@ class SpecializedCpuBatch {
     const EnvSlot s = slot(env, obs_.data() + env * frame_, scratch);
     ep_.reset_env(&assets_, fold(seed_key(seeds_[env]), episode), episode, &s);
   }
-  void record(int32_t env, const StepOutcome& o) {
-    const LatentState& s = latent_[env];
-    info_.reward[env] = o.reward;
-    info_.terminated[env] = o.terminated;
-    info_.truncated[env] = o.truncated;
-    info_.x[env] = s.x;
-    info_.y[env] = s.y;
-    info_.vx[env] = s.vx;
-    info_.vy[env] = s.vy;
-    info_.passed_distance[env] = o.passed_distance;
-    info_.progress[env] = o.progress;
-    info_.success[env] = o.success;
-    info_.success_once[env] = s.success_once;
-    info_.episode_return[env] = s.episode_return;
-    info_.jump_count[env] = s.jump_count;
-    info_.timestep[env] = s.t;
-  }
+  void record(int32_t env, const StepOutcome& o) { info_.record(env, latent_[env], o); }
   /// fn(env, scratch) over a static partition of the environments, one range and scratch per thread.
   template <class Fn>
   void parallel_for(const Fn& fn) {
