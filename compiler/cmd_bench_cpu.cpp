@@ -45,8 +45,8 @@ int cmd_bench(const std::vector<std::string>& args, CommandIo& io) {
   for (int t = warmup; t < total; ++t) env.step(actions.data() + static_cast<size_t>(t) * envs);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double rate = static_cast<double>(steps) * envs / seconds;
-  io.out << config << ": cpu, " << envs << " envs x " << steps << " steps on " << threads << " threads, "
-         << env.height() << "x" << env.width() << " observations: " << static_cast<long long>(rate)
+  io.out << config << ": cpu, " << envs << " envs x " << steps << " steps on " << threads
+         << (threads == 1 ? " thread, " : " threads, ") << env.height() << "x" << env.width() << " observations: " << static_cast<long long>(rate)
          << " env-steps/s (" << seconds << " s)\n";
   return kExitOk;
 }
