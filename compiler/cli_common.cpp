@@ -46,6 +46,25 @@ std::optional<int> parse_args(CLI::App& app, const std::vector<std::string>& arg
   return std::nullopt;
 }
 
+std::optional<Spec> resolve_file(const char* command, const std::string& file, const DiagOptions& opts,
+                                 CommandIo& io, int* exit_code) {
+  SourceManager sources;
+  DiagEngine diags(sources);
+  if (!opts.apply(diags, io)) {
+    *exit_code = kExitUsage;
+    return std::nullopt;
+  }
+  DiskFileReader reader;
+  auto spec = analyze_file(file, opts.resolve_options(), sources, reader, diags);
+  print_text(diags, io.err, io.err_is_terminal);
+  if (!spec || diags.has_errors()) {
+    io.err << "kagec " << command << ": no Spec: fix the errors above\n";
+    *exit_code = kExitErrors;
+    return std::nullopt;
+  }
+  return spec;
+}
+
 void emit_diagnostics(const DiagEngine& diags, const DiagOptions& opts, CommandIo& io) {
   if (opts.format == "json")
     print_json(diags, io.out);

@@ -26,6 +26,11 @@ struct DiagOptions {
 /// Parses `args` into `app`; on --help or a usage error prints and returns the exit code.
 std::optional<int> parse_args(CLI::App& app, const std::vector<std::string>& args, CommandIo& io);
 
+/// Runs the front end on one config and prints its diagnostics. Returns the Spec, or nullopt with
+/// *exit_code set (usage error or errors in the file) after telling the user why.
+std::optional<Spec> resolve_file(const char* command, const std::string& file, const DiagOptions& opts,
+                                 CommandIo& io, int* exit_code);
+
 /// Prints diagnostics in the chosen format.
 void emit_diagnostics(const DiagEngine& diags, const DiagOptions& opts, CommandIo& io);
 

@@ -64,16 +64,9 @@ int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
   app.add_flag("--no-host", no_host, "skip the host compiler (kernels_host.so)");
   opts.add_to(app, false);
   if (auto code = parse_args(app, args, io)) return *code;
-  SourceManager sources;
-  DiagEngine diags(sources);
-  if (!opts.apply(diags, io)) return kExitUsage;
-  DiskFileReader reader;
-  const auto spec = analyze_file(file, opts.resolve_options(), sources, reader, diags);
-  print_text(diags, io.err, io.err_is_terminal);
-  if (!spec || diags.has_errors()) {
-    io.err << "kagec compile: no Spec: fix the errors above\n";
-    return kExitErrors;
-  }
+  int exit_code = kExitOk;
+  const auto spec = resolve_file("compile", file, opts, io, &exit_code);
+  if (!spec) return exit_code;
   const LowerResult lowered = lower_spec(*spec);
   if (!lowered.ok()) {
     io.err << lowered.error_text() << "kagec compile: the runtime cannot hold this config\n";

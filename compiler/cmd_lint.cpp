@@ -35,16 +35,9 @@ int cmd_resolve(const std::vector<std::string>& args, CommandIo& io) {
   app.add_option("-o,--output", output, "write the Spec here instead of standard output");
   opts.add_to(app, false);
   if (auto code = parse_args(app, args, io)) return *code;
-  SourceManager sources;
-  DiagEngine diags(sources);
-  if (!opts.apply(diags, io)) return kExitUsage;
-  DiskFileReader reader;
-  const auto spec = analyze_file(file, opts.resolve_options(), sources, reader, diags);
-  print_text(diags, io.err, io.err_is_terminal);
-  if (!spec || diags.has_errors()) {
-    io.err << "kagec resolve: no Spec: fix the errors above\n";
-    return kExitErrors;
-  }
+  int exit_code = kExitOk;
+  const auto spec = resolve_file("resolve", file, opts, io, &exit_code);
+  if (!spec) return exit_code;
   if (output.empty()) {
     io.out << spec->canonical_text();
   } else {
