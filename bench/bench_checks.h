@@ -5,9 +5,9 @@
 
 #include <string>
 
-#include "bench/asset_blob.h"
 #include "runtime/cuda/module_loader.h"
 #include "runtime/latent/latent_params.h"
+#include "runtime/visual/asset_view.h"
 #include "runtime/visual/visual_params.h"
 
 namespace kage::bench {

@@ -1,23 +1,29 @@
-// kage_gpu_bench: correctness (GPU vs CPU reference) and throughput of the CUDA runtime for the
-// throughput configs, against a device-to-device copy roofline measured in the same run.
+// kage_gpu_bench: correctness (GPU vs CPU reference), load times and throughput of the CUDA runtime
+// for configs compiled by `kagec compile`, against a device-to-device copy roofline measured in the
+// same run.
 //
-// Usage: kage_gpu_bench MODULE_DIR ASSET_BLOB [--min-log2 K] [--max-log2 K] [--check-envs N]
-//                       [--nvrtc-root DIR] [--breakdown] [--skip-checks] [--configs simplest,hardest]
-// MODULE_DIR holds simplest.fatbin, hardest.fatbin and dynamic.fatbin (the bench build's outputs).
+// Usage: kage_gpu_bench GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] [--check-envs N]
+//                       [--nvrtc-root DIR] [--breakdown] [--skip-checks]
+// GENERIC_FATBIN is the bench build's dynamic.fatbin. Each DIR is a `kagec compile` output directory
+// (kernels.fatbin, kage_<hash>.cu, params.bin, assets.bin), named after its last path component;
+// --breakdown needs one named "hardest". With --nvrtc-root (the directory holding runtime/), the
+// generated source is also compiled with NVRTC, cold (empty cache) and warm (disk cache hit).
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "bench/asset_blob.h"
 #include "bench/bench_checks.h"
-#include "bench/bench_configs.h"
 #include "runtime/cuda/device_batch.h"
 #include "runtime/cuda/module_loader.h"
+#include "runtime/host/specialized_assets.h"
 
 namespace kage::bench {
 namespace {
@@ -78,6 +84,7 @@ struct Config {
   const CudaModule* module;
   LatentParams lp;
   VisualParams vp;
+  AssetView assets;
 };
 
 struct Timing {
@@ -91,9 +98,9 @@ enum class StepMode { kFused, kStateOnly, kSplit };
 
 /// Steps/s of the fused step + render, of the state-only step and of the split step + render for n
 /// environments (the last two only with `state_too`).
-Timing time_config(const Config& c, const AssetView& assets, int32_t n, bool state_too) {
+Timing time_config(const Config& c, int32_t n, bool state_too) {
   std::string error;
-  std::optional<DeviceBatch> b = DeviceBatch::create(*c.module, c.lp, c.vp, assets, n, &error);
+  std::optional<DeviceBatch> b = DeviceBatch::create(*c.module, c.lp, c.vp, c.assets, n, &error);
   if (!b) die(c.name + ": " + error);
   std::vector<uint64_t> seeds(n);
   for (int32_t i = 0; i < n; ++i) seeds[i] = static_cast<uint64_t>(i);
@@ -136,9 +143,9 @@ Timing time_config(const Config& c, const AssetView& assets, int32_t n, bool sta
   return out;
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) die(path + ": cannot read");
+std::string read_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) die(path.string() + ": cannot read");
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
@@ -151,9 +158,81 @@ CudaModule load(const std::string& path) {
   return std::move(*m);
 }
 
+SpriteSetTable table_of(const std::vector<SpriteSet>& sets) {
+  SpriteSetTable t{};
+  t.sets = sets.empty() ? nullptr : sets.data();
+  t.count = static_cast<int32_t>(sets.size());
+  for (const SpriteSet& s : sets) t.max_frames = std::max(t.max_frames, s.frame_count);
+  return t;
+}
+
+/// One `kagec compile` directory: its parameters, assets (host copies) and generated source.
+struct CompiledDir {
+  std::string name;
+  std::filesystem::path dir;
+  LatentParams lp{};
+  VisualParams vp{};
+  AssetPack pack;
+  std::string source;       ///< kage_<hash>.cu
+  std::string source_name;
+
+  /// AssetPack::view() lives in the host runtime (image decoders); this program has only the CUDA
+  /// toolkit, so it builds the same pointer view itself.
+  AssetView assets() const {
+    AssetView v{};
+    v.bg = pack.bg.empty() ? nullptr : pack.bg.data();
+    v.bg_count = pack.bg_count;
+    v.bg_h = pack.bg_h;
+    v.bg_w = pack.bg_w;
+    v.sprite_pixels = pack.sprite_pixels.empty() ? nullptr : pack.sprite_pixels.data();
+    v.frames = pack.frames.empty() ? nullptr : pack.frames.data();
+    v.agent_skins = table_of(pack.agent_skins);
+    v.npc_types = table_of(pack.npc_types);
+    v.sticky_types = table_of(pack.sticky_types);
+    return v;
+  }
+};
+
+CompiledDir read_compiled(const std::string& path) {
+  namespace fs = std::filesystem;
+  CompiledDir c;
+  c.dir = fs::path(path);
+  c.name = fs::absolute(c.dir).lexically_normal().filename().string();
+  if (c.name.empty()) c.name = fs::absolute(c.dir).lexically_normal().parent_path().filename().string();
+  const std::string params = read_bytes(c.dir / "params.bin");
+  if (params.size() != sizeof(LatentParams) + sizeof(VisualParams)) die(path + "/params.bin: wrong size (recompile)");
+  std::memcpy(&c.lp, params.data(), sizeof(LatentParams));
+  std::memcpy(&c.vp, params.data() + sizeof(LatentParams), sizeof(VisualParams));
+  std::optional<AssetPack> pack = deserialize_asset_pack(read_bytes(c.dir / "assets.bin"));
+  if (!pack) die(path + "/assets.bin: not an asset blob");
+  c.pack = std::move(*pack);
+  for (const fs::directory_entry& f : fs::directory_iterator(c.dir)) {
+    const std::string n = f.path().filename().string();
+    if (n.starts_with("kage_") && n.ends_with(".cu")) c.source_name = n;
+  }
+  if (c.source_name.empty()) die(path + ": no generated kage_*.cu");
+  c.source = read_bytes(c.dir / c.source_name);
+  return c;
+}
+
+using Clock = std::chrono::steady_clock;
+
+/// Seconds from `start` to the end of the first fused step of 1,024 environments of module `m`.
+double first_step_s(const CudaModule& m, const CompiledDir& c, Clock::time_point start) {
+  std::string error;
+  std::optional<DeviceBatch> b = DeviceBatch::create(m, c.lp, c.vp, c.assets(), 1024, &error);
+  if (!b) die(c.name + ": " + error);
+  std::vector<uint64_t> seeds(1024);
+  for (size_t i = 0; i < seeds.size(); ++i) seeds[i] = i;
+  ok_or_die(b->reset(seeds.data(), &error), error);
+  ok_or_die(b->sample_actions(11, 1, &error), error);
+  ok_or_die(b->step_device_actions(&error), error);
+  cu_or_die(cuCtxSynchronize(), "cuCtxSynchronize");
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 /// Hardest-config variants with one group of stages removed, run through the generic build.
-std::vector<std::pair<std::string, VisualParams>> breakdown_variants() {
-  const VisualParams h = hardest_visual();
+std::vector<std::pair<std::string, VisualParams>> breakdown_variants(const VisualParams& h) {
   std::vector<std::pair<std::string, VisualParams>> v;
   v.emplace_back("hardest (all stages)", h);
   VisualParams p = h;
@@ -191,15 +270,14 @@ std::vector<std::pair<std::string, VisualParams>> breakdown_variants() {
 int main(int argc, char** argv) {
   using namespace kage;
   using namespace kage::bench;
-  if (argc < 3) die("usage: kage_gpu_bench MODULE_DIR ASSET_BLOB [--min-log2 K] [--max-log2 K] [--check-envs N] "
-                    "[--nvrtc-root DIR] [--breakdown]");
-  const std::string dir = argv[1];
+  if (argc < 2) die("usage: kage_gpu_bench GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] "
+                    "[--check-envs N] [--nvrtc-root DIR] [--breakdown] [--skip-checks]");
   int32_t min_log2 = 12, max_log2 = 20, check_envs = 64;
   std::string nvrtc_root;
-  std::string only = "simplest,hardest";
+  std::vector<std::string> dirs;
   bool breakdown = false;
   bool skip_checks = false;
-  for (int i = 3; i < argc; ++i) {
+  for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
       if (i + 1 >= argc) die(a + " needs a value");
@@ -209,17 +287,18 @@ int main(int argc, char** argv) {
     else if (a == "--max-log2") max_log2 = std::atoi(next().c_str());
     else if (a == "--check-envs") check_envs = std::atoi(next().c_str());
     else if (a == "--nvrtc-root") nvrtc_root = next();
-    else if (a == "--configs") only = next();
+    else if (a == "--compiled") {
+      while (i + 1 < argc && std::strncmp(argv[i + 1], "--", 2) != 0) dirs.push_back(argv[++i]);
+    }
     else if (a == "--breakdown") breakdown = true;
     else if (a == "--skip-checks") skip_checks = true;
     else die("unknown option " + a);
   }
-  std::string error;
-  std::optional<AssetBlob> blob = read_asset_blob(argv[2], &error);
-  if (!blob) die(error);
-  const AssetView assets = blob->view();
-  const AssetView no_assets{};
+  if (dirs.empty()) die("no --compiled DIR");
+  std::vector<CompiledDir> compiled;
+  for (const std::string& d : dirs) compiled.push_back(read_compiled(d));
 
+  std::string error;
   CUcontext ctx = cuda_primary_context(&error);
   if (!ctx) die(error);
   CUdevice dev;
@@ -228,55 +307,64 @@ int main(int argc, char** argv) {
   cu_or_die(cuDeviceGetName(name, sizeof name, dev), "cuDeviceGetName");
   std::printf("# kage_gpu_bench on %s\n\n", name);
 
-  const CudaModule simplest = load(dir + "/simplest.fatbin");
-  const CudaModule hardest = load(dir + "/hardest.fatbin");
-  const CudaModule dynamic = load(dir + "/dynamic.fatbin");
-  const Config cfgs[] = {{"simplest", &simplest, yaml_latent(), simplest_visual()},
-                         {"hardest", &hardest, yaml_latent(), hardest_visual()}};
-  auto assets_of = [&](const Config& c) { return c.name == "simplest" ? no_assets : assets; };
-
-  std::printf("## Correctness (GPU vs CPU reference, %d envs, %d steps)\n\n", check_envs, yaml_latent().episode_length + 5);
+  // Load to first step: the fatbin through the driver, then the generated source through NVRTC with
+  // an empty cache (run_device.sh empties it) and again from the disk cache.
+  std::printf("## Load to first step (1,024 envs: load, batch, reset, one fused step)\n\n"
+              "| config | fatbin s | NVRTC cold s | NVRTC warm s (cache hit) |\n|---|---|---|---|\n");
+  std::vector<CudaModule> modules;
   bool all_ok = true;
-  for (const Config& c : skip_checks ? std::vector<Config>{} : std::vector<Config>(std::begin(cfgs), std::end(cfgs))) {
-    // Every config within 1 code per channel: the transcendentals are IEEE-only (kage_math.h), so the
-    // noise samplers draw the same samples on both sides (identical frames expected).
-    const int32_t tol = 1;
+  for (const CompiledDir& c : compiled) {
+    Clock::time_point t0 = Clock::now();
+    modules.push_back(load((c.dir / "kernels.fatbin").string()));
+    const double fatbin_s = first_step_s(modules.back(), c, t0);
+    double times[2] = {0.0, 0.0};
+    bool hits[2] = {false, false};
+    for (int pass = 0; pass < 2 && !nvrtc_root.empty(); ++pass) {
+      const NvrtcOptions o{nvrtc_root, "bench-compiled-1", {}};
+      t0 = Clock::now();
+      std::optional<CudaModule> m = CudaModule::compile(c.source, c.source_name, o, &error, &hits[pass]);
+      if (!m) die("NVRTC: " + error);
+      times[pass] = first_step_s(*m, c, t0);
+      if (pass == 1 && !skip_checks) {
+        const CheckResult r = check_against_cpu(*m, c.lp, c.vp, c.assets(), 16, 8, 0);
+        std::printf("<!-- %s via NVRTC: %s -->\n", c.name.c_str(), r.summary().c_str());
+        all_ok = all_ok && r.ok;
+      }
+    }
+    std::printf("| %s | %.3f | %.3f%s | %.3f%s |\n", c.name.c_str(), fatbin_s, times[0], hits[0] ? " (hit!)" : "",
+                times[1], nvrtc_root.empty() || hits[1] ? "" : " (miss!)");
+    std::fflush(stdout);
+  }
+  const CudaModule dynamic = load(argv[1]);
+  std::vector<Config> cfgs;
+  for (size_t i = 0; i < compiled.size(); ++i)
+    cfgs.push_back({compiled[i].name, &modules[i], compiled[i].lp, compiled[i].vp, compiled[i].assets()});
+
+  std::printf("\n## Correctness (GPU vs CPU reference, %d envs, episode length + 5 steps)\n\n", check_envs);
+  for (const Config& c : skip_checks ? std::vector<Config>{} : cfgs) {
+    // Identical frames expected: the transcendentals are IEEE-only (kage_math.h), so the noise
+    // samplers draw the same samples on both sides.
     for (const auto& [label, module] : {std::pair<std::string, const CudaModule*>{"specialized", c.module},
                                         std::pair<std::string, const CudaModule*>{"generic", &dynamic}}) {
-      const CheckResult r = check_against_cpu(*module, c.lp, c.vp, assets_of(c), check_envs,
-                                              c.lp.episode_length + 5, tol);
+      const CheckResult r = check_against_cpu(*module, c.lp, c.vp, c.assets, check_envs, c.lp.episode_length + 5, 0);
       std::printf("- %s (%s): %s\n", c.name.c_str(), label.c_str(), r.summary().c_str());
-      all_ok = all_ok && r.ok;
-    }
-  }
-  if (!nvrtc_root.empty() && !skip_checks) {
-    NvrtcOptions o{nvrtc_root, "bench-1", {}};
-    const std::string src = read_text(nvrtc_root + "/bench/modules/simplest.cu");
-    for (int pass = 0; pass < 2; ++pass) {
-      bool hit = false;
-      std::optional<CudaModule> m = CudaModule::compile(src, "simplest.cu", o, &error, &hit);
-      if (!m) die("NVRTC: " + error);
-      const CheckResult r = check_against_cpu(*m, yaml_latent(), simplest_visual(), no_assets, 16, 8, 1);
-      std::printf("- simplest via NVRTC (cache %s): %s\n", hit ? "hit" : "miss", r.summary().c_str());
       all_ok = all_ok && r.ok;
     }
   }
   std::fflush(stdout);
 
   const double roof = measure_roofline();
-  std::printf("\n## Roofline\n\ndevice-to-device copy: %.1f GB/s (read + write) = %.1f M frames/s of 128x128x3\n",
+  std::printf("\n## Roofline\n\ndevice-to-device copy: %.1f GB/s (read + write) = %.1f M frames/s of 128x128x3\n\n",
               roof, roof * 1e9 / 49152.0 / 1e6);
-  std::printf("per-env state: %zu bytes (+ %d observation bytes)\n\n", device_state_bytes_per_env(yaml_latent()),
-              128 * 128 * 3);
   std::printf("## Throughput\n\n| config | envs | steps/s with obs (fused) | obs GB/s | %% of roofline | "
               "split step+render steps/s | split %% of roofline | steps/s state only |\n"
               "|---|---|---|---|---|---|---|---|\n");
   for (const Config& c : cfgs) {
-    if (only.find(c.name) == std::string::npos) continue;
+    const double frame_bytes = 3.0 * c.vp.H * c.vp.W;
     for (int32_t k = min_log2; k <= max_log2; ++k) {
-      const Timing t = time_config(c, assets_of(c), 1 << k, true);
-      const double gbs = t.render_steps_per_s * 49152.0 / 1e9;
-      const double split_gbs = t.split_steps_per_s * 49152.0 / 1e9;
+      const Timing t = time_config(c, 1 << k, true);
+      const double gbs = t.render_steps_per_s * frame_bytes / 1e9;
+      const double split_gbs = t.split_steps_per_s * frame_bytes / 1e9;
       std::printf("| %s | 2^%d | %.3g | %.0f | %.1f | %.3g | %.1f | %.3g |\n", c.name.c_str(), k,
                   t.render_steps_per_s, gbs, 100.0 * gbs / roof, t.split_steps_per_s, 100.0 * split_gbs / roof,
                   t.state_steps_per_s);
@@ -284,14 +372,15 @@ int main(int argc, char** argv) {
     }
   }
   if (breakdown) {
+    const auto hardest = std::find_if(cfgs.begin(), cfgs.end(), [](const Config& c) { return c.name == "hardest"; });
+    if (hardest == cfgs.end()) die("--breakdown needs a compiled dir named hardest");
     std::printf("\n## Hardest, stages removed (generic build, 2^14 envs)\n\n| variant | steps/s with obs |\n|---|---|\n");
-    for (const auto& [label, vp] : breakdown_variants()) {
-      const Config c{"hardest", &dynamic, yaml_latent(), vp};
-      std::printf("| %s | %.3g |\n", label.c_str(), time_config(c, assets, 1 << 14, false).render_steps_per_s);
+    for (const auto& [label, vp] : breakdown_variants(hardest->vp)) {
+      const Config c{"hardest", &dynamic, hardest->lp, vp, hardest->assets};
+      std::printf("| %s | %.3g |\n", label.c_str(), time_config(c, 1 << 14, false).render_steps_per_s);
       std::fflush(stdout);
     }
-    std::printf("| hardest, specialized build | %.3g |\n",
-                time_config(cfgs[1], assets, 1 << 14, false).render_steps_per_s);
+    std::printf("| hardest, specialized build | %.3g |\n", time_config(*hardest, 1 << 14, false).render_steps_per_s);
   }
   std::printf("\n%s\n", all_ok ? "all checks passed" : "SOME CHECKS FAILED");
   return all_ok ? 0 : 1;

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# One device-machine call: build the GPU benchmark if no build was carried, then check (GPU vs CPU) and
-# time everything, logging under $OUT. The asset blob (build-bench/data/assets.bin) is made here with
-# kage_asset_blob (it needs image decoders) and carried along with the build.
-# Usage on the device: bash bench/run_device.sh [kage_gpu_bench options]
+# One device-machine call: build the GPU benchmark if no build was carried, then check (GPU vs CPU),
+# time loading and stepping, logging under $OUT. The configs are `kagec compile` output directories
+# (bench-data/simplest, bench-data/hardest by default: the device build has no front end, so carry
+# them), made here with: kagec compile configs/throughput/NAME.yaml -o bench-data/NAME --no-host
+# Usage on the device: bash bench/run_device.sh [kage_gpu_bench options]   (BENCH_DIRS overrides the dirs)
 set -uo pipefail
 OUT=${OUT:-/tmp/kage-bench-out}
 BUILD=${BUILD:-build-bench}
+DIRS=${BENCH_DIRS:-bench-data/simplest bench-data/hardest}
 mkdir -p "$OUT"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,clocks.mem --format=csv >"$OUT/gpu.txt" 2>&1
 cat "$OUT/gpu.txt"
@@ -15,7 +17,10 @@ if [ ! -x "$BUILD/bench/kage_gpu_bench" ]; then
 fi
 # NVRTC is opened at run time; the toolkit directory is often not on the loader path.
 export LD_LIBRARY_PATH=/usr/local/cuda/lib64:${LD_LIBRARY_PATH:-}
+# An empty cache, so that the first NVRTC load of each config is cold.
 export KAGE_CACHE_DIR=/tmp/kage-cache
 rm -rf "$KAGE_CACHE_DIR"
-"$BUILD/bench/kage_gpu_bench" "$BUILD/bench" "$BUILD/data/assets.bin" --nvrtc-root "$PWD" "$@" 2>&1 | tee "$OUT/bench.log"
+# shellcheck disable=SC2086
+"$BUILD/bench/kage_gpu_bench" "$BUILD/bench/dynamic.fatbin" --compiled $DIRS --nvrtc-root "$PWD" "$@" 2>&1 |
+  tee "$OUT/bench.log"
 exit "${PIPESTATUS[0]}"

@@ -121,6 +121,7 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
   }
   b.render_threads_ = render_threads(vp);
   b.render_smem_ = render_dynamic_smem_bytes(vp);
+  b.frames_per_block_ = frames_per_block(vp);
   for (CUfunction f : {b.step_render_, b.render_}) {
     if (!check(cuFuncSetAttribute(f, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, b.render_smem_),
                "cuFuncSetAttribute(dynamic shared memory)", error))
@@ -192,6 +193,7 @@ DeviceBatch::DeviceBatch(DeviceBatch&& o) noexcept
       obs_stride_(o.obs_stride_),
       render_threads_(o.render_threads_),
       render_smem_(o.render_smem_),
+      frames_per_block_(o.frames_per_block_),
       state_(o.state_),
       obs_buf_(o.obs_buf_),
       assets_(o.assets_),
@@ -217,7 +219,8 @@ bool DeviceBatch::launch_per_env(CUfunction f, std::string* error) {
 
 bool DeviceBatch::launch_per_block(CUfunction f, std::string* error) {
   void* args[] = {&envs_};
-  return check(cuLaunchKernel(f, static_cast<unsigned>(envs_.num_envs), 1, 1, static_cast<unsigned>(render_threads_),
+  const unsigned grid = static_cast<unsigned>((envs_.num_envs + frames_per_block_ - 1) / frames_per_block_);
+  return check(cuLaunchKernel(f, grid, 1, 1, static_cast<unsigned>(render_threads_),
                               1, 1, static_cast<unsigned>(render_smem_), nullptr, args, nullptr),
                "cuLaunchKernel", error);
 }

@@ -72,6 +72,7 @@ class DeviceBatch {
   size_t obs_stride_ = 0;
   int32_t render_threads_ = 0;
   int32_t render_smem_ = 0;
+  int32_t frames_per_block_ = 1;
   CUdeviceptr state_ = 0;   ///< one allocation for every per-env array but the observations
   CUdeviceptr obs_buf_ = 0;
   CUdeviceptr assets_ = 0;

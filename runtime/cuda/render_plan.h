@@ -1,15 +1,20 @@
 // How a config's frames are rendered on the GPU: per pixel in registers, or with the neighbourhood
 // filters (blur, sharpen, pixelate, cyberpunk's sharpen) from a float32 frame in shared memory.
-// Read by the kernels (a constant in a specialized build) and by the host that sizes the launch.
+// Read by the kernels (a constant in a specialized build) and by the host that sizes the launch, with
+// the shared-memory slots of one frame.
 #pragma once
 
 #include "runtime/kage_hd.h"
+#include "runtime/latent/latent_state.h"
+#include "runtime/visual/compose.h"
 #include "runtime/visual/filter_ops.h"
+#include "runtime/visual/filters.h"
 #include "runtime/visual/visual_params.h"
+#include "runtime/visual/visual_state.h"
 
 namespace kage {
 
-/// Capacities of a rendering block's shared state (kernels.cuh BlockShared): layout bytes and screen
+/// Capacities of a rendering block's shared state (BlockShared below): layout bytes and screen
 /// columns. DeviceBatch rejects configs beyond them.
 constexpr int32_t kMaxLayoutBytes = 4096;
 constexpr int32_t kMaxScreenWidth = 1024;
@@ -17,7 +22,7 @@ constexpr int32_t kMaxScreenWidth = 1024;
 /// Pixels per thread: one 48-byte run of a row (three 16-byte stores) in the register path, a
 /// strided set of 16 pixels in the frame-pass path.
 constexpr int32_t kPixelsPerThread = 16;
-/// Threads of a register-path block (one frame per block).
+/// Threads of a register-path block (one frame per block, or one per warp: render_by_warps).
 constexpr int32_t kRegisterPathThreads = 256;
 /// Pixels per thread of the frame-pass path (strided), and its largest block: every pixel of the frame
 /// belongs to one of its threads. 512 threads of 32 pixels rather than 1024 of 16: the register cap
@@ -25,6 +30,52 @@ constexpr int32_t kRegisterPathThreads = 256;
 /// the banded passes keep only two pixels' results in registers whatever the pixel count.
 constexpr int32_t kFramePassPixelsPerThread = 32;
 constexpr int32_t kFramePassMaxThreads = 512;
+/// Widest frame a warp renders alone (the width of its column table in shared memory).
+constexpr int32_t kWarpPathMaxWidth = 256;
+constexpr int32_t kWarpsPerBlock = kRegisterPathThreads / 32;
+
+/// Solid rows [lo, hi) of one screen column, packed as two 16-bit values.
+struct ColumnSpan {
+  short lo;
+  short hi;
+};
+
+/// Values shared by every pixel of one frame, computed once per frame.
+struct FrameSetup {
+  FrameConstants f;
+  AgentView agent;
+  Preset episode_preset;
+  FilterKeys keys;
+  float jitter[9];
+  ScreenBox agent_box;  ///< outside it the agent leaves pixels unchanged
+  bool plain;           ///< every pixel outside agent_box is a function of solid() alone (register path)
+};
+
+/// The extremes of the solid spans of one 16-column group: a row outside [lo_min, hi_max) is empty in
+/// every column of the group and a row in [lo_max, hi_min) solid in every column.
+struct GroupSpan {
+  short lo_min, lo_max, hi_min, hi_max;
+};
+
+/// Shared memory of a rendering block besides the optional float frame.
+struct BlockShared {
+  LatentState latent;
+  FrameSetup setup;
+  alignas(16) VisualState visual;
+  alignas(16) uint8_t segments[kMaxLayoutBytes];
+  ColumnSpan spans[kMaxScreenWidth];
+  GroupSpan groups[kMaxScreenWidth / kPixelsPerThread];
+};
+
+/// One warp's frame in the dynamic shared memory of a warp-path block: as BlockShared
+/// without the layout, which the warp reads from global memory (only its column table is per pixel).
+struct WarpSlot {
+  LatentState latent;
+  FrameSetup setup;
+  alignas(16) VisualState visual;
+  ColumnSpan spans[kWarpPathMaxWidth];
+  GroupSpan groups[kWarpPathMaxWidth / kPixelsPerThread];
+};
 
 /// Whether any frame pass can run: a sharpening preset in pop_filter_list or pop_filter, blur,
 /// sharpen or pixelate (spec 7.1 steps A, 8-10).
@@ -39,6 +90,13 @@ KAGE_HD bool needs_frame_passes(const VisualParams& p) {
 /// Whether the register path can store whole 16-pixel runs (each row a multiple of 16 pixels).
 KAGE_HD bool register_path_vectorized(const VisualParams& p) { return p.W % kPixelsPerThread == 0; }
 
+/// Whether each warp renders its own frame (register path, frame at most kWarpPathMaxWidth wide):
+/// a block renders kWarpsPerBlock frames at once from WarpSlots in dynamic shared memory.
+KAGE_HD bool render_by_warps(const VisualParams& p) { return !needs_frame_passes(p) && p.W <= kWarpPathMaxWidth; }
+
+/// Frames a rendering block renders at once.
+KAGE_HD int32_t frames_per_block(const VisualParams& p) { return render_by_warps(p) ? kWarpsPerBlock : 1; }
+
 /// Threads per rendering block.
 KAGE_HD int32_t render_threads(const VisualParams& p) {
   if (!needs_frame_passes(p)) return kRegisterPathThreads;
@@ -46,10 +104,11 @@ KAGE_HD int32_t render_threads(const VisualParams& p) {
   return (per + 31) / 32 * 32;
 }
 
-/// Dynamic shared memory of a rendering block: the float32 frame of the frame-pass path; the register
-/// path packs its pixels in registers and needs none (so more of its blocks fit on an SM).
+/// Dynamic shared memory of a rendering block: the float32 frame of the frame-pass path, the warps'
+/// slots of the warp path; a block-wide register path packs its pixels in registers and needs none.
 KAGE_HD int32_t render_dynamic_smem_bytes(const VisualParams& p) {
-  return needs_frame_passes(p) ? p.H * p.W * 3 * static_cast<int32_t>(sizeof(float)) : 0;
+  if (needs_frame_passes(p)) return p.H * p.W * 3 * static_cast<int32_t>(sizeof(float));
+  return render_by_warps(p) ? kWarpsPerBlock * static_cast<int32_t>(sizeof(WarpSlot)) : 0;
 }
 
 /// Whether the GPU kernels support this frame size: the frame-pass path holds one frame per block.
