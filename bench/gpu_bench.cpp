@@ -3,11 +3,14 @@
 // same run.
 //
 // Usage: kage_gpu_bench GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] [--check-envs N]
-//                       [--nvrtc-root DIR] [--breakdown] [--skip-checks]
+//                       [--nvrtc-root DIR] [--breakdown] [--skip-checks] [--check-only]
 // GENERIC_FATBIN is the bench build's dynamic.fatbin. Each DIR is a `kagec compile` output directory
 // (kernels.fatbin, kage_<hash>.cu, params.bin, assets.bin), named after its last path component;
 // --breakdown needs one named "hardest". With --nvrtc-root (the directory holding runtime/), the
 // generated source is also compiled with NVRTC, cold (empty cache) and warm (disk cache hit).
+// --check-only checks every DIR through the generic build against the CPU reference (observations
+// within 1 code) and stops: DIRs need only params.bin and assets.bin (kagec compile --no-gpu), so all
+// shipped configs can be checked without building a fatbin for each.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -210,7 +213,7 @@ CompiledDir read_compiled(const std::string& path) {
     const std::string n = f.path().filename().string();
     if (n.starts_with("kage_") && n.ends_with(".cu")) c.source_name = n;
   }
-  if (c.source_name.empty()) die(path + ": no generated kage_*.cu");
+  if (c.source_name.empty()) return c;  // --check-only needs no source; the NVRTC pass checks for one
   c.source = read_bytes(c.dir / c.source_name);
   return c;
 }
@@ -264,6 +267,31 @@ std::vector<std::pair<std::string, VisualParams>> breakdown_variants(const Visua
   return v;
 }
 
+/// Every dir through the generic build: state identical, observations within 1 code (the generic
+/// build must match the CPU on every shipped config, not only on the two timed ones). Returns the
+/// exit status.
+int check_only(const CudaModule& dynamic, const std::vector<CompiledDir>& dirs, int32_t envs) {
+  std::printf("## Generic build vs CPU reference, every config (%d envs, episode length + 5 steps)\n\n"
+              "| config | episode length | steps | state mismatches | obs max diff | obs equal %% | result |\n"
+              "|---|---|---|---|---|---|---|\n", envs);
+  int32_t passed = 0;
+  for (const CompiledDir& c : dirs) {
+    const int32_t steps = c.lp.episode_length + 5;
+    const CheckResult r = check_against_cpu(dynamic, c.lp, c.vp, c.assets(), envs, steps, 1);
+    if (!r.error.empty()) {
+      std::printf("| %s | %d | %d | - | - | - | error: %s |\n", c.name.c_str(), c.lp.episode_length, steps,
+                  r.error.c_str());
+    } else {
+      std::printf("| %s | %d | %d | %d | %d | %.4f | %s |\n", c.name.c_str(), c.lp.episode_length, steps,
+                  r.state_mismatches, r.obs_max_abs, 100.0 * r.obs_equal, r.ok ? "PASS" : "FAIL");
+    }
+    std::fflush(stdout);
+    passed += r.ok ? 1 : 0;
+  }
+  std::printf("\n%d of %zu configs passed\n", passed, dirs.size());
+  return passed == static_cast<int32_t>(dirs.size()) ? 0 : 1;
+}
+
 }  // namespace
 }  // namespace kage::bench
 
@@ -271,12 +299,13 @@ int main(int argc, char** argv) {
   using namespace kage;
   using namespace kage::bench;
   if (argc < 2) die("usage: kage_gpu_bench GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] "
-                    "[--check-envs N] [--nvrtc-root DIR] [--breakdown] [--skip-checks]");
+                    "[--check-envs N] [--nvrtc-root DIR] [--breakdown] [--skip-checks] [--check-only]");
   int32_t min_log2 = 12, max_log2 = 20, check_envs = 64;
   std::string nvrtc_root;
   std::vector<std::string> dirs;
   bool breakdown = false;
   bool skip_checks = false;
+  bool only_checks = false;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -292,6 +321,7 @@ int main(int argc, char** argv) {
     }
     else if (a == "--breakdown") breakdown = true;
     else if (a == "--skip-checks") skip_checks = true;
+    else if (a == "--check-only") only_checks = true;
     else die("unknown option " + a);
   }
   if (dirs.empty()) die("no --compiled DIR");
@@ -306,6 +336,7 @@ int main(int argc, char** argv) {
   cu_or_die(cuCtxGetDevice(&dev), "cuCtxGetDevice");
   cu_or_die(cuDeviceGetName(name, sizeof name, dev), "cuDeviceGetName");
   std::printf("# kage_gpu_bench on %s\n\n", name);
+  if (only_checks) return check_only(load(argv[1]), compiled, check_envs);
 
   // Load to first step: the fatbin through the driver, then the generated source through NVRTC with
   // an empty cache (run_device.sh empties it) and again from the disk cache.
@@ -320,6 +351,7 @@ int main(int argc, char** argv) {
     double times[2] = {0.0, 0.0};
     bool hits[2] = {false, false};
     for (int pass = 0; pass < 2 && !nvrtc_root.empty(); ++pass) {
+      if (c.source_name.empty()) die(c.dir.string() + ": no generated kage_*.cu");
       const NvrtcOptions o{nvrtc_root, "bench-compiled-1", {}};
       t0 = Clock::now();
       std::optional<CudaModule> m = CudaModule::compile(c.source, c.source_name, o, &error, &hits[pass]);

@@ -4,6 +4,8 @@
 # (bench-data/simplest, bench-data/hardest by default: the device build has no front end, so carry
 # them), made here with: kagec compile configs/throughput/NAME.yaml -o bench-data/NAME --no-host
 # Usage on the device: bash bench/run_device.sh [kage_gpu_bench options]   (BENCH_DIRS overrides the dirs)
+# Every shipped config (generic build vs CPU): kagec compile CFG -o bench-data/all/ID --no-gpu --no-host here,
+# then on the device: BENCH_DIRS="bench-data/all/*" bash bench/run_device.sh --check-only --check-envs 32
 set -uo pipefail
 OUT=${OUT:-/tmp/kage-bench-out}
 BUILD=${BUILD:-build-bench}

@@ -7,7 +7,8 @@
 //
 // Observations are [N][H][W][3] uint8. Frames without neighbourhood filters (render_by_warps): each
 // warp of a block steps and renders its own environment (lane 0 steps while the block's other warps
-// render), composing 16-pixel runs in registers (register_path.cuh). Frames with blur, sharpen or
+// render), composing 16-pixel runs in registers (register_path.cuh); the render-only kernel renders
+// them block-wide. Frames with blur, sharpen or
 // pixelate: one block per frame, thread 0 steps in shared memory, then the block runs the stages as
 // passes over a float32 frame in shared memory (frame_pass.cuh).
 #pragma once
@@ -185,10 +186,28 @@ __device__ __forceinline__ void step_render_body(const DeviceEnvs& e, BlockShare
   }
 }
 
-/// Render only: the current states (after reset, or for timing), as step_render_body without the step.
+/// Render only: the current states (after reset, or after the state-only step). Warp-path configs are
+/// rendered block-wide here, a block's kWarpsPerBlock frames one after the other: with no step to hide,
+/// a frame's serial setup (lane 0's constants, the column table) is shared by the block instead of
+/// being repeated by each warp, so the state-only step (one thread per environment) plus this kernel
+/// is the "step by warps, render block-wide" split, timed beside the fused warp kernel.
 template <class Cfg>
 __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh, float* frame) {
-  if (render_by_warps(ParamsOf<Cfg>::visual())) return warp_frames<Cfg>(e, reinterpret_cast<WarpSlot*>(frame), false);
+  if (render_by_warps(ParamsOf<Cfg>::visual())) {
+    for (int32_t first = static_cast<int32_t>(blockIdx.x) * kWarpsPerBlock; first < e.num_envs;
+         first += static_cast<int32_t>(gridDim.x) * kWarpsPerBlock) {
+      const int32_t last = first + kWarpsPerBlock < e.num_envs ? first + kWarpsPerBlock : e.num_envs;
+      for (int32_t env = first; env < last; ++env) {
+        group_copy_words<BlockGroup>(&sh.latent, e.latent + env, static_cast<int32_t>(sizeof(LatentState)));
+        group_copy_words<BlockGroup>(&sh.visual, e.visual + env, e.visual_extent);
+        __syncthreads();
+        render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
+                                      frame_of<Cfg>(e, env));
+        __syncthreads();
+      }
+    }
+    return;
+  }
   for (int32_t env = static_cast<int32_t>(blockIdx.x); env < e.num_envs; env += static_cast<int32_t>(gridDim.x)) {
     load_state<Cfg>(e, env, sh);
     render_frame<Cfg, BlockGroup>(e, env, sh, sh.segments, frame, frame_of<Cfg>(e, env));
