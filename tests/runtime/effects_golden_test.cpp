@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "runtime/host/image_io.h"
+#include "tests/runtime/golden_image_support.h"
 #include "runtime/visual/image_diff.h"
 #include "runtime/visual/lights.h"
 
@@ -20,13 +21,6 @@ const std::string kEffects = std::string(KAGE_SOURCE_DIR) + "/../shared/golden/e
 const std::map<std::string, kage::Rgb> kLightColors = {
     {"blue", {100, 150, 255}}, {"pink", {255, 150, 200}}, {"gold", {255, 215, 0}}};
 
-kage::Image load_rgb(const std::string& path) {
-  kage::ImageResult r = kage::load_image(path, 3);
-  INFO(r.error);
-  REQUIRE(r.ok());
-  return *r.image;
-}
-
 }  // namespace
 
 TEST_CASE("point lights reproduce the golden lit frames", "[visual][golden]") {
@@ -37,8 +31,8 @@ TEST_CASE("point lights reproduce the golden lit frames", "[visual][golden]") {
   int worst_max = 0;
   double worst_equal = 1.0;
   for (const auto& [name, c] : index.items()) {
-    const kage::Image unlit = load_rgb(kEffects + name + "_unlit.png");
-    const kage::Image lit = load_rgb(kEffects + name + "_lit.png");
+    const kage::Image unlit = kage::test::load_rgb(kEffects + name + "_unlit.png");
+    const kage::Image lit = kage::test::load_rgb(kEffects + name + "_lit.png");
     const nlohmann::json& fx = c["effects"];
     kage::VisualParams p = kage::identity_visual_params(unlit.height, unlit.width);
     p.point_light_enabled = fx["point_light_enabled"].get<bool>();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "runtime/host/image_io.h"
+#include "tests/runtime/golden_image_support.h"
 #include "runtime/visual/filters.h"
 #include "runtime/visual/image_diff.h"
 
@@ -45,13 +46,6 @@ kage::VisualParams case_params(const nlohmann::json& settings, int H, int W) {
   return p;
 }
 
-kage::Image load_rgb(const std::string& path) {
-  kage::ImageResult r = kage::load_image(path, 3);
-  INFO(r.error);
-  REQUIRE(r.ok());
-  return *r.image;
-}
-
 }  // namespace
 
 TEST_CASE("filter chain reproduces every golden filter case", "[visual][golden]") {
@@ -59,7 +53,7 @@ TEST_CASE("filter chain reproduces every golden filter case", "[visual][golden]"
   REQUIRE(in.good());
   const nlohmann::json index = nlohmann::json::parse(in);
   REQUIRE(index.size() >= 28);
-  const kage::Image base = load_rgb(kFilters + "base.png");
+  const kage::Image base = kage::test::load_rgb(kFilters + "base.png");
   const int n = base.width * base.height * 3;
   std::vector<float> f(n), tmp(n);
   int worst_max = 0;
@@ -70,7 +64,7 @@ TEST_CASE("filter chain reproduces every golden filter case", "[visual][golden]"
     std::vector<uint8_t> img = base.pixels;
     kage::apply_filters(p, kage::Preset::kNone, kage::filter_keys(kage::Key{0, 0}, 0), img.data(), f.data(),
                         tmp.data());
-    const kage::Image expected = load_rgb(kFilters + name + ".png");
+    const kage::Image expected = kage::test::load_rgb(kFilters + name + ".png");
     REQUIRE(expected.pixels.size() == img.size());
     const kage::ImageDiff d = kage::image_diff(img.data(), expected.pixels.data(), n);
     // The case must change the frame (no pass on an untouched input).
@@ -87,7 +81,7 @@ TEST_CASE("filter chain reproduces every golden filter case", "[visual][golden]"
 TEST_CASE("per-episode preset goes through uint8 before the main chain", "[visual]") {
   // A preset from pop_filter_list alone equals the same preset as pop_filter on an identity chain
   // (both end in a truncation to uint8); stacking both applies it twice (spec 11.41).
-  const kage::Image base = load_rgb(kFilters + "base.png");
+  const kage::Image base = kage::test::load_rgb(kFilters + "base.png");
   const int n = base.width * base.height * 3;
   std::vector<float> f(n), tmp(n);
   kage::VisualParams single = kage::identity_visual_params(base.height, base.width);
