@@ -18,21 +18,18 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "bench/bench_checks.h"
+#include "bench/gpu_measure.h"
 #include "runtime/cuda/device_batch.h"
 #include "runtime/cuda/module_loader.h"
 #include "runtime/host/specialized_assets.h"
 
 namespace kage::bench {
 namespace {
-
-constexpr int32_t kRepeats = 5;
-constexpr int32_t kWarmupSteps = 3;
 
 [[noreturn]] void die(const std::string& msg) {
   std::fprintf(stderr, "kage_gpu_bench: %s\n", msg.c_str());
@@ -47,104 +44,10 @@ void cu_or_die(CUresult r, const char* what) {
   if (r != CUDA_SUCCESS) die(cu_error_text(r, what));
 }
 
-/// Median of kRepeats timings (ms) of `run_once`, each bracketed by events on the default stream.
-double median_ms(const std::function<void()>& run_once) {
-  CUevent a, b;
-  cu_or_die(cuEventCreate(&a, CU_EVENT_DEFAULT), "cuEventCreate");
-  cu_or_die(cuEventCreate(&b, CU_EVENT_DEFAULT), "cuEventCreate");
-  std::vector<double> t;
-  for (int32_t i = 0; i < kRepeats; ++i) {
-    cu_or_die(cuEventRecord(a, nullptr), "cuEventRecord");
-    run_once();
-    cu_or_die(cuEventRecord(b, nullptr), "cuEventRecord");
-    cu_or_die(cuEventSynchronize(b), "cuEventSynchronize");
-    float ms = 0.0f;
-    cu_or_die(cuEventElapsedTime(&ms, a, b), "cuEventElapsedTime");
-    t.push_back(ms);
-  }
-  cu_or_die(cuEventDestroy(a), "cuEventDestroy");
-  cu_or_die(cuEventDestroy(b), "cuEventDestroy");
-  std::sort(t.begin(), t.end());
-  return t[t.size() / 2];
-}
-
-/// Device-to-device copy bandwidth in GB/s (bytes read + written), 4 GiB each way.
-double measure_roofline() {
-  const size_t bytes = size_t{4} << 30;
-  CUdeviceptr src, dst;
-  cu_or_die(cuMemAlloc(&src, bytes), "cuMemAlloc(roofline)");
-  cu_or_die(cuMemAlloc(&dst, bytes), "cuMemAlloc(roofline)");
-  cu_or_die(cuMemsetD8(src, 0x5A, bytes), "cuMemsetD8");
-  cu_or_die(cuMemcpyDtoD(dst, src, bytes), "cuMemcpyDtoD");
-  const double ms = median_ms([&] { cu_or_die(cuMemcpyDtoD(dst, src, bytes), "cuMemcpyDtoD"); });
-  cu_or_die(cuMemFree(src), "cuMemFree");
-  cu_or_die(cuMemFree(dst), "cuMemFree");
-  return 2.0 * static_cast<double>(bytes) / (ms * 1e-3) / 1e9;
-}
-
-struct Config {
+/// One timed config: its name and what its batches run with.
+struct Config : MeasureTarget {
   std::string name;
-  const CudaModule* module;
-  LatentParams lp;
-  VisualParams vp;
-  AssetView assets;
 };
-
-struct Timing {
-  double render_steps_per_s;
-  double state_steps_per_s;
-  double split_steps_per_s;  ///< state-only step kernel, then the render kernel
-};
-
-/// How a timed step runs: fused step + render, state only, or the two kernels one after the other.
-enum class StepMode { kFused, kStateOnly, kSplit };
-
-/// Steps/s of the fused step + render, of the state-only step and of the split step + render for n
-/// environments (the last two only with `state_too`).
-Timing time_config(const Config& c, int32_t n, bool state_too) {
-  std::string error;
-  std::optional<DeviceBatch> b = DeviceBatch::create(*c.module, c.lp, c.vp, c.assets, n, &error);
-  if (!b) die(c.name + ": " + error);
-  std::vector<uint64_t> seeds(n);
-  for (int32_t i = 0; i < n; ++i) seeds[i] = static_cast<uint64_t>(i);
-  ok_or_die(b->reset(seeds.data(), &error), error);
-  uint32_t t = 0;
-  auto steps = [&](int32_t count, StepMode mode) {
-    for (int32_t s = 0; s < count; ++s) {
-      ok_or_die(b->sample_actions(11, ++t, &error), error);
-      ok_or_die(mode == StepMode::kFused ? b->step_device_actions(&error) : b->step_no_render(&error), error);
-      if (mode == StepMode::kSplit) ok_or_die(b->render(&error), error);
-    }
-  };
-  // Each timed repeat runs enough steps for about 100 ms, judged from one timed warm-up step.
-  auto steps_per_repeat = [&](StepMode render) {
-    steps(kWarmupSteps - 1, render);
-    CUevent a, b2;
-    cu_or_die(cuEventCreate(&a, CU_EVENT_DEFAULT), "cuEventCreate");
-    cu_or_die(cuEventCreate(&b2, CU_EVENT_DEFAULT), "cuEventCreate");
-    cu_or_die(cuEventRecord(a, nullptr), "cuEventRecord");
-    steps(1, render);
-    cu_or_die(cuEventRecord(b2, nullptr), "cuEventRecord");
-    cu_or_die(cuEventSynchronize(b2), "cuEventSynchronize");
-    float ms = 0.0f;
-    cu_or_die(cuEventElapsedTime(&ms, a, b2), "cuEventElapsedTime");
-    cu_or_die(cuEventDestroy(a), "cuEventDestroy");
-    cu_or_die(cuEventDestroy(b2), "cuEventDestroy");
-    return std::clamp(static_cast<int32_t>(100.0f / std::max(ms, 1e-3f)), 1, 1024);
-  };
-  auto rate = [&](StepMode mode) {
-    const int32_t k = steps_per_repeat(mode);
-    const double ms = median_ms([&] { steps(k, mode); });
-    return static_cast<double>(n) * k / (ms * 1e-3);
-  };
-  Timing out{rate(StepMode::kFused), 0.0, 0.0};
-  if (state_too) {
-    out.state_steps_per_s = rate(StepMode::kStateOnly);
-    out.split_steps_per_s = rate(StepMode::kSplit);
-  }
-  cu_or_die(cuCtxSynchronize(), "cuCtxSynchronize");
-  return out;
-}
 
 std::string read_bytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -295,7 +198,9 @@ int check_only(const CudaModule& dynamic, const std::vector<CompiledDir>& dirs, 
 }  // namespace
 }  // namespace kage::bench
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   using namespace kage;
   using namespace kage::bench;
   if (argc < 2) die("usage: kage_gpu_bench GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] "
@@ -370,7 +275,7 @@ int main(int argc, char** argv) {
   const CudaModule dynamic = load(argv[1]);
   std::vector<Config> cfgs;
   for (size_t i = 0; i < compiled.size(); ++i)
-    cfgs.push_back({compiled[i].name, &modules[i], compiled[i].lp, compiled[i].vp, compiled[i].assets()});
+    cfgs.push_back({{&modules[i], compiled[i].lp, compiled[i].vp, compiled[i].assets()}, compiled[i].name});
 
   std::printf("\n## Correctness (GPU vs CPU reference, %d envs, episode length + 5 steps)\n\n", check_envs);
   for (const Config& c : skip_checks ? std::vector<Config>{} : cfgs) {
@@ -394,7 +299,7 @@ int main(int argc, char** argv) {
   for (const Config& c : cfgs) {
     const double frame_bytes = 3.0 * c.vp.H * c.vp.W;
     for (int32_t k = min_log2; k <= max_log2; ++k) {
-      const Timing t = time_config(c, 1 << k, true);
+      const Timing t = time_config(c, 1 << k, true, true);
       const double gbs = t.render_steps_per_s * frame_bytes / 1e9;
       const double split_gbs = t.split_steps_per_s * frame_bytes / 1e9;
       std::printf("| %s | 2^%d | %.3g | %.0f | %.1f | %.3g | %.1f | %.3g |\n", c.name.c_str(), k,
@@ -408,12 +313,22 @@ int main(int argc, char** argv) {
     if (hardest == cfgs.end()) die("--breakdown needs a compiled dir named hardest");
     std::printf("\n## Hardest, stages removed (generic build, 2^14 envs)\n\n| variant | steps/s with obs |\n|---|---|\n");
     for (const auto& [label, vp] : breakdown_variants(hardest->vp)) {
-      const Config c{"hardest", &dynamic, hardest->lp, vp, hardest->assets};
-      std::printf("| %s | %.3g |\n", label.c_str(), time_config(c, 1 << 14, false).render_steps_per_s);
+      const MeasureTarget c{&dynamic, hardest->lp, vp, hardest->assets};
+      std::printf("| %s | %.3g |\n", label.c_str(), time_config(c, 1 << 14, true, false).render_steps_per_s);
       std::fflush(stdout);
     }
-    std::printf("| hardest, specialized build | %.3g |\n", time_config(*hardest, 1 << 14, false).render_steps_per_s);
+    std::printf("| hardest, specialized build | %.3g |\n", time_config(*hardest, 1 << 14, true, false).render_steps_per_s);
   }
   std::printf("\n%s\n", all_ok ? "all checks passed" : "SOME CHECKS FAILED");
   return all_ok ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const kage::bench::MeasureError& e) {
+    kage::bench::die(e.what());
+  }
 }

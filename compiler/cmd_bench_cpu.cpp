@@ -1,8 +1,10 @@
-// kagec bench --cpu: environment steps per second of the CPU runtime, observations rendered.
+// kagec bench: environment steps per second. --cpu: the CPU runtime, observations rendered, here;
+// --gpu: bench_gpu (compiler/cmd_bench_gpu.cpp), in builds with the CUDA toolkit.
 #include <chrono>
 #include <ostream>
 #include <thread>
 
+#include "compiler/bench_gpu.h"
 #include "compiler/cli_common.h"
 #include "compiler/environment.h"
 #include "runtime/rng.h"
@@ -12,17 +14,36 @@ namespace kage {
 int cmd_bench(const std::vector<std::string>& args, CommandIo& io) {
   CLI::App app("Measure environment steps per second (observations rendered).", "bench");
   std::string config, asset_root;
-  bool cpu = false;
+  bool cpu = false, gpu = false;
+  GpuBenchOptions gpu_options;
   int envs = 64, steps = 200, warmup = 10;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  app.add_option("config", config, "config file")->required();
-  app.add_flag("--cpu", cpu, "run the CPU runtime (the only backend of this command so far)")->required();
+  app.add_option("config", config, "config file (with --gpu also a suite manifest: each distinct config of its pairs)")
+      ->required();
+  CLI::Option* cpu_flag = app.add_flag("--cpu", cpu, "run the CPU runtime");
+  app.add_flag("--gpu", gpu, "compile in-process (NVRTC) and run on the GPU, against a copy roofline")->excludes(cpu_flag);
+  app.add_option("--min-log2", gpu_options.min_log2, "--gpu: smallest batch, 2^K envs")->check(CLI::Range(0, 24));
+  app.add_option("--max-log2", gpu_options.max_log2, "--gpu: largest batch, 2^K envs")->check(CLI::Range(0, 24));
+  app.add_flag("--no-render", gpu_options.no_render, "--gpu: time only the step without rendering");
   app.add_option("--envs", envs, "environments in the batch")->check(CLI::PositiveNumber);
   app.add_option("--steps", steps, "timed steps of the whole batch")->check(CLI::PositiveNumber);
   app.add_option("--warmup", warmup, "untimed steps before the timed ones")->check(CLI::NonNegativeNumber);
   app.add_option("--threads", threads, "worker threads (default: all cores)")->check(CLI::PositiveNumber);
   app.add_option("--asset-root", asset_root, "resolve asset paths against this directory");
   if (auto code = parse_args(app, args, io)) return *code;
+  if (!cpu && !gpu) {
+    io.err << "kagec bench: choose a backend: --cpu or --gpu\n";
+    return kExitUsage;
+  }
+  if (gpu) {
+#if defined(KAGE_HAVE_GPU_BENCH)
+    gpu_options.file = config;
+    return bench_gpu(gpu_options, io);
+#else
+    io.err << "kagec bench --gpu: this kagec was built without the CUDA toolkit\n";
+    return kExitErrors;
+#endif
+  }
   EnvironmentOptions options;
   options.num_envs = envs;
   options.num_threads = threads;

@@ -17,7 +17,7 @@ const std::vector<Command>& commands() {
       {"rules", "list every diagnostic rule with its severity", cmd_rules},
       {"schema", "print the configuration JSON Schema (for editors)", cmd_schema},
       {"render", "run one environment and write its frames as PNG, GIF or a contact sheet", cmd_render},
-      {"bench", "measure environment steps per second (--cpu)", cmd_bench},
+      {"bench", "measure environment steps per second (--cpu, or --gpu against a copy roofline)", cmd_bench},
       {"golden", "check the runtime against the reference data of the original (golden check)", cmd_golden},
       {"docs", "print a reference page: config-keys or diagnostics", cmd_docs},
   };
