@@ -41,38 +41,22 @@ KAGE_HD float fmod(float a, float b) { return KAGE_MATH_FN(fmod)(a, b); }
 // compute the same bits. Accuracy: log/exp < 1 ulp (fdlibm's float algorithms), pow/sin/cos through
 // double arithmetic (error ~1e-14 before the final rounding to float).
 
-KAGE_HD uint32_t float_bits(float f) {
+/// Reinterprets the bytes of one trivially copyable value as another of the same size
+/// (std::bit_cast is not available under NVRTC).
+template <class To, class From>
+KAGE_HD To bit_cast_hd(From from) {
+  static_assert(sizeof(To) == sizeof(From), "bit_cast_hd needs equal sizes");
   union {
-    float f;
-    uint32_t u;
+    From from;
+    To to;
   } v;
-  v.f = f;
-  return v.u;
+  v.from = from;
+  return v.to;
 }
-KAGE_HD float bits_float(uint32_t u) {
-  union {
-    uint32_t u;
-    float f;
-  } v;
-  v.u = u;
-  return v.f;
-}
-KAGE_HD uint64_t double_bits(double d) {
-  union {
-    double d;
-    uint64_t u;
-  } v;
-  v.d = d;
-  return v.u;
-}
-KAGE_HD double bits_double(uint64_t u) {
-  union {
-    uint64_t u;
-    double d;
-  } v;
-  v.u = u;
-  return v.d;
-}
+KAGE_HD uint32_t float_bits(float f) { return bit_cast_hd<uint32_t>(f); }
+KAGE_HD float bits_float(uint32_t u) { return bit_cast_hd<float>(u); }
+KAGE_HD uint64_t double_bits(double d) { return bit_cast_hd<uint64_t>(d); }
+KAGE_HD double bits_double(uint64_t u) { return bit_cast_hd<double>(u); }
 
 #if defined(__CUDACC__)
 KAGE_HD double floor_d(double v) { return ::floor(v); }
