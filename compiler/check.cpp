@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "compiler/spell.h"
+#include "compiler/utf8.h"
 
 namespace kage {
 
@@ -39,16 +40,17 @@ std::string describe_types(const std::set<std::string>& types) {
   return out;
 }
 
-// Reports a name not in its table, with a did-you-mean fix-it.
-void check_name(const KeySchema& key, const NameTable& table, const DocNode& node, const std::string& name,
+// Reports a name not in its table, with a did-you-mean fix-it; false if reported.
+bool check_name(const KeySchema& key, const NameTable& table, const DocNode& node, const std::string& name,
                 DiagEngine& diags) {
   for (const std::string& n : table.names)
-    if (n == name) return;
+    if (n == name) return true;
   const auto guess = suggest(name, table.names);
   std::string msg = "unknown " + table.title + " '" + name + "' for '" + key.path + "'";
   msg += guess ? "; did you mean '" + *guess + "'?" : "; valid names: " + quoted_list(table.names);
   Diagnostic& d = diags.report(Rule::SchemaUnknownName, node.range, msg, key.pointer);
   if (guess) d.fixits.push_back({node.range, *guess});
+  return false;
 }
 
 // One scalar against a value rule; returns false if it was reported.
@@ -144,6 +146,10 @@ void check_value(const KeySchema& key, const DocNode& value, DiagEngine& diags) 
                  "'" + key.path + "' is a string, which the original reads as a list of its characters; write a list: [" +
                      value.text + "]",
                  key.pointer);
+    // Each character is then an entry; the first one that is not a name is what the original trips over.
+    if (key.items && key.items->names)
+      for (const std::string& ch : utf8_characters(std::get<std::string>(v)))
+        if (!check_name(key, *key.items->names, value, ch, diags)) break;
     return;
   }
   if (std::holds_alternative<std::string>(v) && key.string_as_list && key.items) {

@@ -8,6 +8,7 @@
 #include "compiler/conditions.h"
 #include "compiler/lints.h"
 #include "compiler/lower.h"
+#include "compiler/utf8.h"
 
 namespace kage {
 
@@ -48,7 +49,7 @@ Json value_json(const KeySchema& key, const DocNode& node) {
   if (v.is_string() && key.ctype == "string_list") {
     if (key.string_is_characters) {  // spec 2.2: a string there is a list of its characters
       Json chars = Json::array();
-      for (char c : v.get<std::string>()) chars.push_back(std::string(1, c));
+      for (std::string& c : utf8_characters(v.get<std::string>())) chars.push_back(std::move(c));
       return chars;
     }
     return Json::array({v});

@@ -1,6 +1,8 @@
 // yaml-cpp nodes -> DocNode trees with byte ranges; PyYAML-compatible scalar typing.
 #include "compiler/yaml_doc.h"
 
+#include "compiler/utf8.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -171,28 +173,6 @@ class Converter {
   DiagEngine& diags_;
   const std::string& text_;
 };
-
-// The offset of the first byte that does not belong to a well-formed UTF-8 sequence.
-std::optional<size_t> invalid_utf8_offset(const std::string& text) {
-  size_t i = 0;
-  while (i < text.size()) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
-    if (len == 0 || (len == 2 && c < 0xC2) || (len == 4 && c > 0xF4) || i + len > text.size()) return i;
-    for (size_t k = 1; k < len; ++k)
-      if ((static_cast<unsigned char>(text[i + k]) & 0xC0) != 0x80) return i;
-    if (len == 3) {
-      const auto c1 = static_cast<unsigned char>(text[i + 1]);
-      if ((c == 0xE0 && c1 < 0xA0) || (c == 0xED && c1 >= 0xA0)) return i;  // overlong, surrogate
-    }
-    if (len == 4) {
-      const auto c1 = static_cast<unsigned char>(text[i + 1]);
-      if ((c == 0xF0 && c1 < 0x90) || (c == 0xF4 && c1 >= 0x90)) return i;
-    }
-    i += len;
-  }
-  return std::nullopt;
-}
 
 }  // namespace
 

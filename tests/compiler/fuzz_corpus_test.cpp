@@ -31,6 +31,8 @@ std::vector<std::string> seed_corpus() {
   out.push_back("character:\n  fallback_color: [1, 2]\n  shape_types: ''\n");
   out.push_back("");
   out.push_back("\xEF\xBB\xBF" "H: 64\n");
+  // Multi-byte characters where a string is read as a list of its characters.
+  out.push_back("background: {mode: color, color_names: \"b\xDE\x96\"}\nfilters: {pop_filter_list: \"\xE2\x82\xAC\"}\n");
   return out;
 }
 

@@ -1,0 +1,19 @@
+// UTF-8 helpers: config files are UTF-8 text (as PyYAML requires), and the
+// original iterates strings by code point.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kage {
+
+/// The offset of the first byte that does not belong to a well-formed UTF-8
+/// sequence, or nullopt when the whole text is well-formed.
+std::optional<size_t> invalid_utf8_offset(const std::string& text);
+
+/// The characters (code points, each as its UTF-8 bytes) of well-formed text,
+/// as Python's list(str) gives them.
+std::vector<std::string> utf8_characters(const std::string& text);
+
+}  // namespace kage
