@@ -22,7 +22,7 @@ struct CheckResult {
   std::string summary() const;
 };
 
-/// Runs reset and `steps` fused steps (random actions; checkpoints at reset, steps 1-3, 100 and around
+/// Runs reset and `steps` steps (random actions; checkpoints at reset, steps 1-3, 100 and around
 /// the first automatic reset) on `envs` environments, then the state-only kernel over the same steps.
 /// Passes when every state matches and observations differ by at most `max_code_diff`.
 CheckResult check_against_cpu(const CudaModule& module, const LatentParams& lp, const VisualParams& vp,

@@ -19,7 +19,7 @@ class CpuReference {
   CpuReference(const LatentParams& lp, const VisualParams& vp, const AssetView& assets, int32_t num_envs);
   /// Episode 0 of every environment.
   void reset(const std::vector<uint64_t>& seeds);
-  /// One step with automatic reset (the order of the fused kernel).
+  /// One step with automatic reset (the order of the step kernel).
   void step(const std::vector<int32_t>& actions);
   /// Renders every environment's current state into `obs` ([N][H][W][3]) with `threads` workers.
   void render(std::vector<uint8_t>& obs, int32_t threads) const;

@@ -123,7 +123,7 @@ CompiledDir read_compiled(const std::string& path) {
 
 using Clock = std::chrono::steady_clock;
 
-/// Seconds from `start` to the end of the first fused step of 1,024 environments of module `m`.
+/// Seconds from `start` to the end of the first step of 1,024 environments of module `m`.
 double first_step_s(const CudaModule& m, const CompiledDir& c, Clock::time_point start) {
   std::string error;
   std::optional<DeviceBatch> b = DeviceBatch::create(m, c.lp, c.vp, c.assets(), 1024, &error);
@@ -245,7 +245,7 @@ int run(int argc, char** argv) {
 
   // Load to first step: the fatbin through the driver, then the generated source through NVRTC with
   // an empty cache (run_device.sh empties it) and again from the disk cache.
-  std::printf("## Load to first step (1,024 envs: load, batch, reset, one fused step)\n\n"
+  std::printf("## Load to first step (1,024 envs: load, batch, reset, one step)\n\n"
               "| config | fatbin s | NVRTC cold s | NVRTC warm s (cache hit) |\n|---|---|---|---|\n");
   std::vector<CudaModule> modules;
   bool all_ok = true;
@@ -293,18 +293,15 @@ int run(int argc, char** argv) {
   const double roof = measure_roofline();
   std::printf("\n## Roofline\n\ndevice-to-device copy: %.1f GB/s (read + write) = %.1f M frames/s of 128x128x3\n\n",
               roof, roof * 1e9 / 49152.0 / 1e6);
-  std::printf("## Throughput\n\n| config | envs | steps/s with obs (fused) | obs GB/s | %% of roofline | "
-              "split step+render steps/s | split %% of roofline | steps/s state only |\n"
-              "|---|---|---|---|---|---|---|---|\n");
+  std::printf("## Throughput\n\n| config | envs | steps/s with obs | obs GB/s | %% of roofline | steps/s state only |\n"
+              "|---|---|---|---|---|---|\n");
   for (const Config& c : cfgs) {
     const double frame_bytes = 3.0 * c.vp.H * c.vp.W;
     for (int32_t k = min_log2; k <= max_log2; ++k) {
       const Timing t = time_config(c, 1 << k, true, true);
       const double gbs = t.render_steps_per_s * frame_bytes / 1e9;
-      const double split_gbs = t.split_steps_per_s * frame_bytes / 1e9;
-      std::printf("| %s | 2^%d | %.3g | %.0f | %.1f | %.3g | %.1f | %.3g |\n", c.name.c_str(), k,
-                  t.render_steps_per_s, gbs, 100.0 * gbs / roof, t.split_steps_per_s, 100.0 * split_gbs / roof,
-                  t.state_steps_per_s);
+      std::printf("| %s | 2^%d | %.3g | %.0f | %.1f | %.3g |\n", c.name.c_str(), k, t.render_steps_per_s, gbs,
+                  100.0 * gbs / roof, t.state_steps_per_s);
       std::fflush(stdout);
     }
   }

@@ -21,8 +21,8 @@ void ok_or_throw(bool ok, const std::string& error) {
   if (!ok) throw MeasureError(error);
 }
 
-/// How a timed step runs: fused step + render, state only, or the two kernels one after the other.
-enum class StepMode { kFused, kStateOnly, kSplit };
+/// How a timed step runs: with observations (DeviceBatch's step), or state only.
+enum class StepMode { kWithObs, kStateOnly };
 
 }  // namespace
 
@@ -70,8 +70,7 @@ Timing time_config(const MeasureTarget& c, int32_t n, bool render, bool state_to
   auto steps = [&](int32_t count, StepMode mode) {
     for (int32_t s = 0; s < count; ++s) {
       ok_or_throw(b->sample_actions(11, ++t, &error), error);
-      ok_or_throw(mode == StepMode::kFused ? b->step_device_actions(&error) : b->step_no_render(&error), error);
-      if (mode == StepMode::kSplit) ok_or_throw(b->render(&error), error);
+      ok_or_throw(mode == StepMode::kWithObs ? b->step_device_actions(&error) : b->step_no_render(&error), error);
     }
   };
   // Each timed repeat runs enough steps for about 100 ms, judged from one timed warm-up step.
@@ -95,11 +94,7 @@ Timing time_config(const MeasureTarget& c, int32_t n, bool render, bool state_to
     const double ms = median_ms([&] { steps(k, mode); });
     return static_cast<double>(n) * k / (ms * 1e-3);
   };
-  Timing out{render ? rate(StepMode::kFused) : 0.0, 0.0, 0.0};
-  if (state_too) {
-    out.state_steps_per_s = rate(StepMode::kStateOnly);
-    if (render) out.split_steps_per_s = rate(StepMode::kSplit);
-  }
+  Timing out{render ? rate(StepMode::kWithObs) : 0.0, state_too ? rate(StepMode::kStateOnly) : 0.0};
   cu_or_throw(cuCtxSynchronize(), "cuCtxSynchronize");
   return out;
 }

@@ -1,5 +1,5 @@
 // The throughput measurements shared by kage_gpu_bench and `kagec bench --gpu`: a device-to-device
-// copy roofline and the step rates of one batch (fused step + render, state only, split), so both
+// copy roofline and the step rates of one batch (step + render, state only), so both
 // report numbers taken the same way.
 #pragma once
 
@@ -37,13 +37,12 @@ struct MeasureTarget {
 /// Steps/s of n environments (each step: random actions sampled on the device, then the step).
 /// Rates that were not asked for are 0.
 struct Timing {
-  double render_steps_per_s;  ///< fused step + autoreset + render
+  double render_steps_per_s;  ///< DeviceBatch's step: step + autoreset, then render the observations
   double state_steps_per_s;   ///< state-only step (observations left as they were)
-  double split_steps_per_s;   ///< state-only step kernel, then the render kernel
 };
 
-/// Times one batch of n environments: the fused rate when `render`, the state-only rate when
-/// `state_too`, and the split rate when both.
+/// Times one batch of n environments: the rate with observations when `render`, the state-only rate
+/// when `state_too`.
 Timing time_config(const MeasureTarget& t, int32_t n, bool render, bool state_too);
 
 }  // namespace kage::bench

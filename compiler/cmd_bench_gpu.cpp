@@ -135,8 +135,8 @@ int bench_gpu(const GpuBenchOptions& o, CommandIo& io) {
   try {
     const double roof = bench::measure_roofline();
     io.out << "kagec bench --gpu on " << name << ": roofline (device-to-device copy, read + write) " << fixed(roof, 1)
-           << " GB/s\n\n| config | envs | steps/s with obs (fused) | obs GB/s | % of roofline | "
-              "split step+render steps/s | steps/s no render |\n|---|---|---|---|---|---|---|\n";
+           << " GB/s\n\n| config | envs | steps/s with obs | obs GB/s | % of roofline | steps/s no render |\n"
+              "|---|---|---|---|---|---|\n";
     for (const Prepared& c : configs) {
       const bench::MeasureTarget target{&c.module, c.config.latent, c.config.visual, c.pack.view()};
       const double frame_bytes = 3.0 * c.config.visual.H * c.config.visual.W;
@@ -145,10 +145,10 @@ int bench_gpu(const GpuBenchOptions& o, CommandIo& io) {
         const double gbs = t.render_steps_per_s * frame_bytes / 1e9;
         io.out << "| " << c.label << " | 2^" << k << " | ";
         if (o.no_render) {
-          io.out << "- | - | - | - | ";
+          io.out << "- | - | - | ";
         } else {
           io.out << rate_text(t.render_steps_per_s) << " | " << fixed(gbs, 0) << " | " << fixed(100.0 * gbs / roof, 1)
-                 << " | " << rate_text(t.split_steps_per_s) << " | ";
+                 << " | ";
         }
         io.out << rate_text(t.state_steps_per_s) << " |\n" << std::flush;
       }

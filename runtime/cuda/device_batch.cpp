@@ -84,8 +84,8 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
     *error = "DeviceBatch: the environment count must be positive";
     return std::nullopt;
   }
-  if (!latent_params_supported(lp) || segment_stride_bytes(layout_segment_count(lp)) > kMaxLayoutBytes) {
-    *error = "DeviceBatch: layout parameters not supported (at most " + std::to_string(kMaxLayoutBytes) + " segments)";
+  if (!latent_params_supported(lp)) {
+    *error = "DeviceBatch: layout parameters not supported";
     return std::nullopt;
   }
   if (!render_supported(vp)) {
@@ -94,8 +94,7 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
     return std::nullopt;
   }
   DeviceBatch b;
-  for (auto [fn, name] : {std::pair{&b.reset_, "kage_reset"}, std::pair{&b.step_render_, "kage_step_render"},
-                          std::pair{&b.step_only_, "kage_step_only"}, std::pair{&b.render_, "kage_render"},
+  for (auto [fn, name] : {std::pair{&b.reset_, "kage_reset"}, std::pair{&b.step_, "kage_step"}, std::pair{&b.render_, "kage_render"},
                           std::pair{&b.sample_actions_, "kage_sample_actions"}}) {
     *fn = module.function(name, error);
     if (!*fn) return std::nullopt;
@@ -122,11 +121,9 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
   b.render_threads_ = render_threads(vp);
   b.render_smem_ = render_dynamic_smem_bytes(vp);
   b.frames_per_block_ = frames_per_block(vp);
-  for (CUfunction f : {b.step_render_, b.render_}) {
-    if (!check(cuFuncSetAttribute(f, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, b.render_smem_),
-               "cuFuncSetAttribute(dynamic shared memory)", error))
-      return std::nullopt;
-  }
+  if (!check(cuFuncSetAttribute(b.render_, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, b.render_smem_),
+             "cuFuncSetAttribute(dynamic shared memory)", error))
+    return std::nullopt;
 
   // Assets: one allocation, pointers rebased.
   const AssetView& ha = host_assets;
@@ -198,8 +195,7 @@ DeviceBatch::DeviceBatch(DeviceBatch&& o) noexcept
       obs_buf_(o.obs_buf_),
       assets_(o.assets_),
       reset_(o.reset_),
-      step_render_(o.step_render_),
-      step_only_(o.step_only_),
+      step_(o.step_),
       render_(o.render_),
       sample_actions_(o.sample_actions_) {
   o.state_ = o.obs_buf_ = o.assets_ = 0;
@@ -217,10 +213,10 @@ bool DeviceBatch::launch_per_env(CUfunction f, std::string* error) {
   return check(cuLaunchKernel(f, grid, 1, 1, kPerEnvThreads, 1, 1, 0, nullptr, args, nullptr), "cuLaunchKernel", error);
 }
 
-bool DeviceBatch::launch_per_block(CUfunction f, std::string* error) {
+bool DeviceBatch::launch_render(std::string* error) {
   void* args[] = {&envs_};
   const unsigned grid = static_cast<unsigned>((envs_.num_envs + frames_per_block_ - 1) / frames_per_block_);
-  return check(cuLaunchKernel(f, grid, 1, 1, static_cast<unsigned>(render_threads_),
+  return check(cuLaunchKernel(render_, grid, 1, 1, static_cast<unsigned>(render_threads_),
                               1, 1, static_cast<unsigned>(render_smem_), nullptr, args, nullptr),
                "cuLaunchKernel", error);
 }
@@ -228,7 +224,7 @@ bool DeviceBatch::launch_per_block(CUfunction f, std::string* error) {
 bool DeviceBatch::reset(const uint64_t* seeds, std::string* error) {
   const CUdeviceptr d = reinterpret_cast<CUdeviceptr>(envs_.seeds);
   return check(cuMemcpyHtoD(d, seeds, sizeof(uint64_t) * envs_.num_envs), "cuMemcpyHtoD(seeds)", error) &&
-         launch_per_env(reset_, error) && launch_per_block(render_, error);
+         launch_per_env(reset_, error) && launch_render(error);
 }
 
 bool DeviceBatch::step(const int32_t* actions, std::string* error) {
@@ -237,11 +233,15 @@ bool DeviceBatch::step(const int32_t* actions, std::string* error) {
          step_device_actions(error);
 }
 
-bool DeviceBatch::step_device_actions(std::string* error) { return launch_per_block(step_render_, error); }
+bool DeviceBatch::step_device_actions(std::string* error) { return step_no_render(error) && launch_render(error); }
 
-bool DeviceBatch::step_no_render(std::string* error) { return launch_per_env(step_only_, error); }
+bool DeviceBatch::step_no_render(std::string* error) { return launch_per_env(step_, error); }
 
-bool DeviceBatch::render(std::string* error) { return launch_per_block(render_, error); }
+bool DeviceBatch::download_obs(uint8_t* host, std::string* error) const {
+  return check(cuMemcpyDtoH(host, obs(), obs_stride_ * static_cast<size_t>(envs_.num_envs)), "cuMemcpyDtoH(obs)", error);
+}
+
+bool DeviceBatch::render(std::string* error) { return launch_render(error); }
 
 bool DeviceBatch::sample_actions(uint64_t seed, uint32_t t, std::string* error) {
   int32_t* actions = const_cast<int32_t*>(envs_.actions);

@@ -40,9 +40,9 @@ class DeviceBatch {
 
   /// Starts episode 0 of every environment (`seeds`: size() host values) and renders the observations.
   bool reset(const uint64_t* seeds, std::string* error);
-  /// Uploads size() host actions and runs one fused step + autoreset + render.
+  /// Uploads size() host actions and runs one step (with autoreset), then renders the observations.
   bool step(const int32_t* actions, std::string* error);
-  /// One fused step with the actions already in device memory (actions()).
+  /// step() with the actions already in device memory (actions()).
   bool step_device_actions(std::string* error);
   /// One step without rendering (observations are left as they were).
   bool step_no_render(std::string* error);
@@ -54,6 +54,8 @@ class DeviceBatch {
   int32_t size() const { return envs_.num_envs; }
   /// Device pointers ([N][H][W][3] uint8, [N] float, [N] uint8, [N] uint8, [N] StepInfo, [N] int32).
   CUdeviceptr obs() const { return reinterpret_cast<CUdeviceptr>(envs_.obs); }
+  /// Copies every observation into host memory (size() * obs_bytes_per_env() bytes).
+  bool download_obs(uint8_t* host, std::string* error) const;
   CUdeviceptr reward() const { return reinterpret_cast<CUdeviceptr>(envs_.reward); }
   CUdeviceptr terminated() const { return reinterpret_cast<CUdeviceptr>(envs_.terminated); }
   CUdeviceptr truncated() const { return reinterpret_cast<CUdeviceptr>(envs_.truncated); }
@@ -66,7 +68,8 @@ class DeviceBatch {
  private:
   DeviceBatch() = default;
   bool launch_per_env(CUfunction f, std::string* error);
-  bool launch_per_block(CUfunction f, std::string* error);
+  /// Launches the render kernel: frames_per_block_ environments per block.
+  bool launch_render(std::string* error);
 
   DeviceEnvs envs_{};
   size_t obs_stride_ = 0;
@@ -77,8 +80,7 @@ class DeviceBatch {
   CUdeviceptr obs_buf_ = 0;
   CUdeviceptr assets_ = 0;
   CUfunction reset_ = nullptr;
-  CUfunction step_render_ = nullptr;
-  CUfunction step_only_ = nullptr;
+  CUfunction step_ = nullptr;
   CUfunction render_ = nullptr;
   CUfunction sample_actions_ = nullptr;
 };

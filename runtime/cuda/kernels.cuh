@@ -1,16 +1,17 @@
-// CUDA kernels of one configuration: reset, fused step + autoreset + render, step without rendering,
-// and render only. Templates over a config type `Cfg` with `static constexpr LatentParams latent()` and
-// `static constexpr VisualParams visual()` (a generated config: every parameter folds, and every stage's
-// plain `if` on a parameter sees a constant, so disabled stages vanish) or over DynamicCfg (parameters
-// read from __constant__ memory, one build for every config). Compiles under nvcc and NVRTC: the
-// semantics headers and these files use no host headers.
+// CUDA kernels of one configuration: reset, step (with autoreset, one thread per environment), render,
+// and random actions for benchmarks. Templates over a config type `Cfg` with `static constexpr
+// LatentParams latent()` and `static constexpr VisualParams visual()` (a generated config: every
+// parameter folds, and every stage's plain `if` on a parameter sees a constant, so disabled stages
+// vanish) or over DynamicCfg (parameters read from __constant__ memory, one build for every config).
+// Compiles under nvcc and NVRTC: the semantics headers and these files use no host headers.
 //
-// Observations are [N][H][W][3] uint8. Frames without neighbourhood filters (render_by_warps): each
-// warp of a block steps and renders its own environment (lane 0 steps while the block's other warps
-// render), composing 16-pixel runs in registers (register_path.cuh); the render-only kernel renders
-// them block-wide. Frames with blur, sharpen or
-// pixelate: one block per frame, thread 0 steps in shared memory, then the block runs the stages as
-// passes over a float32 frame in shared memory (frame_pass.cuh).
+// A step with observations is the step kernel, then the render kernel: the step is serial per
+// environment and runs 32 environments per warp; the render is parallel per pixel and runs one frame
+// per block at a time. (A fused kernel that stepped inside the rendering block was slower: its serial
+// step and per-frame setup held up the frame's pixels.) Observations are [N][H][W][3] uint8. Frames
+// without neighbourhood filters take the register path (register_path.cuh; frames_per_block() frames
+// per block, one after the other); frames with blur, sharpen or pixelate take the frame-pass path, a
+// float32 frame in shared memory (frame_pass.cuh).
 #pragma once
 
 #include "runtime/cuda/frame_pass.cuh"
@@ -21,8 +22,7 @@ namespace kage {
 
 /// Renders the state held in `sh` into `out` with the threads of `Group`: frame setup by its first
 /// thread, the column table from the layout at `segments`, then the pixels. Entered by every thread of
-/// the group; the state in `sh` must be complete. `frame` is the float frame of the frame-pass path
-/// (block groups only).
+/// the group; the state in `sh` must be complete. `frame` is the float frame of the frame-pass path.
 template <class Cfg, class Group, class Slot>
 __device__ __forceinline__ void render_frame(const DeviceEnvs& e, int32_t env, Slot& sh, const uint8_t* segments,
                                              float* frame, uint8_t* out) {
@@ -43,7 +43,7 @@ __device__ __forceinline__ void render_frame(const DeviceEnvs& e, int32_t env, S
     }
   }
   // The distractors' per-frame shape values (up to 20 sin/cos each) beside the first thread: on the
-  // second warp of a block, on the other lanes of a warp.
+  // block's second warp (on the first warp's other lanes when the block is a single warp).
   const int32_t dist_first = Group::size() > 32 ? 32 : 1;
   if (Group::rank() >= dist_first)
     for (int32_t i = Group::rank() - dist_first; i < distractor_slots(vp); i += Group::size() - dist_first)
@@ -71,30 +71,8 @@ __device__ __forceinline__ void render_frame(const DeviceEnvs& e, int32_t env, S
     Group::sync();
   }
   const SpanSolid solid{sh.spans, cam, lp.height_px};
-  if constexpr (Group::kWholeBlock) {
-    if (needs_frame_passes(vp)) {
-      render_frame_pass_path<Cfg>(e.assets, sh, solid, frame, out);
-      return;
-    }
-  }
+  if (needs_frame_passes(vp)) return render_frame_pass_path<Cfg>(e.assets, sh, solid, frame, out);
   render_register_path<Cfg, Group>(e.assets, sh, solid, out);
-}
-
-/// Loads one environment's state into shared memory with the whole block.
-template <class Cfg>
-__device__ __forceinline__ void load_state(const DeviceEnvs& e, int32_t env, BlockShared& sh) {
-  group_copy_words<BlockGroup>(&sh.latent, e.latent + env, static_cast<int32_t>(sizeof(LatentState)));
-  group_copy_words<BlockGroup>(sh.segments, e.segments + static_cast<int64_t>(env) * e.segment_stride, e.segment_stride);
-  group_copy_words<BlockGroup>(&sh.visual, e.visual + env, e.visual_extent);
-  __syncthreads();
-}
-
-/// Stores one environment's state from shared memory with the whole block (after a barrier).
-template <class Cfg>
-__device__ __forceinline__ void store_state(const DeviceEnvs& e, int32_t env, const BlockShared& sh) {
-  group_copy_words<BlockGroup>(e.latent + env, &sh.latent, static_cast<int32_t>(sizeof(LatentState)));
-  group_copy_words<BlockGroup>(e.segments + static_cast<int64_t>(env) * e.segment_stride, sh.segments, e.segment_stride);
-  group_copy_words<BlockGroup>(e.visual + env, &sh.visual, e.visual_extent);
 }
 
 /// The frame of environment env.
@@ -104,8 +82,8 @@ __device__ __forceinline__ uint8_t* frame_of(const DeviceEnvs& e, int32_t env) {
   return e.obs + static_cast<int64_t>(env) * vp.H * vp.W * 3;
 }
 
-/// Launch bounds of the rendering kernels: at most a frame-pass block; a config that certainly takes
-/// the register path (no neighbourhood filter, no preset: tested on constants, as needs_frame_passes is
+/// Launch bounds of the render kernel: at most a frame-pass block; a config that certainly takes the
+/// register path (no neighbourhood filter, no preset: tested on constants, as needs_frame_passes is
 /// not constexpr) asks for two such blocks' worth, i.e. four 256-thread blocks per SM (64 registers).
 template <class Cfg>
 struct RenderBounds {
@@ -136,9 +114,10 @@ __device__ __forceinline__ void reset_body(const DeviceEnvs& e) {
   record_outcome(e, env, ls, StepOutcome{});
 }
 
-/// Step without rendering: one thread per environment (the original's state-only measurement).
+/// Step with autoreset: one thread per environment; the render kernel then draws the observations
+/// (run alone, the state-only measurement of the original's own benchmark).
 template <class Cfg>
-__device__ __forceinline__ void step_only_body(const DeviceEnvs& e) {
+__device__ __forceinline__ void step_body(const DeviceEnvs& e) {
   const int32_t env = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (env >= e.num_envs) return;
   LatentState ls = e.latent[env];
@@ -147,71 +126,23 @@ __device__ __forceinline__ void step_only_body(const DeviceEnvs& e) {
   e.latent[env] = ls;
 }
 
-/// Warp path of the fused step (`step`) or of a render only: warp w of block b takes environments
-/// b * kWarpsPerBlock + w, + gridDim * kWarpsPerBlock, ...; lane 0 steps the state in global memory
-/// (as step_only_body), then the warp copies it into its slot and renders it.
-template <class Cfg>
-__device__ __forceinline__ void warp_frames(const DeviceEnvs& e, WarpSlot* slots, bool step) {
-  const int32_t warp = static_cast<int32_t>(threadIdx.x) / 32;
-  WarpSlot& sh = slots[warp];
-  for (int32_t env = static_cast<int32_t>(blockIdx.x) * kWarpsPerBlock + warp; env < e.num_envs;
-       env += static_cast<int32_t>(gridDim.x) * kWarpsPerBlock) {
-    uint8_t* segments = e.segments + static_cast<int64_t>(env) * e.segment_stride;
-    if (step && WarpGroup::rank() == 0) {
-      LatentState ls = e.latent[env];
-      device_step_env(ParamsOf<Cfg>::latent(), ParamsOf<Cfg>::visual(), e, env, segments, ls, e.visual[env]);
-      e.latent[env] = ls;
-    }
-    WarpGroup::sync();
-    group_copy_words<WarpGroup>(&sh.latent, e.latent + env, static_cast<int32_t>(sizeof(LatentState)));
-    group_copy_words<WarpGroup>(&sh.visual, e.visual + env, e.visual_extent);
-    WarpGroup::sync();
-    render_frame<Cfg, WarpGroup>(e, env, sh, segments, nullptr, frame_of<Cfg>(e, env));
-    WarpGroup::sync();
-  }
-}
-
-/// Fused step + autoreset + render: one frame per warp (warp_frames) or one block per environment
-/// (grid-stride over environments).
-template <class Cfg>
-__device__ __forceinline__ void step_render_body(const DeviceEnvs& e, BlockShared& sh, float* frame) {
-  if (render_by_warps(ParamsOf<Cfg>::visual())) return warp_frames<Cfg>(e, reinterpret_cast<WarpSlot*>(frame), true);
-  for (int32_t env = static_cast<int32_t>(blockIdx.x); env < e.num_envs; env += static_cast<int32_t>(gridDim.x)) {
-    load_state<Cfg>(e, env, sh);
-    if (threadIdx.x == 0) device_step_env(ParamsOf<Cfg>::latent(), ParamsOf<Cfg>::visual(), e, env, sh.segments, sh.latent, sh.visual);
-    __syncthreads();
-    store_state<Cfg>(e, env, sh);
-    render_frame<Cfg, BlockGroup>(e, env, sh, sh.segments, frame, frame_of<Cfg>(e, env));
-    __syncthreads();
-  }
-}
-
-/// Render only: the current states (after reset, or after the state-only step). Warp-path configs are
-/// rendered block-wide here, a block's kWarpsPerBlock frames one after the other: with no step to hide,
-/// a frame's serial setup (lane 0's constants, the column table) is shared by the block instead of
-/// being repeated by each warp, so the state-only step (one thread per environment) plus this kernel
-/// is the "step by warps, render block-wide" split, timed beside the fused warp kernel.
+/// Render: the current states (after reset or step). Block b renders environments
+/// [b * k, b * k + k), + gridDim * k, ..., k = frames_per_block(), one after the other with the whole
+/// block; the layout is read from global memory (only its column table is per pixel).
 template <class Cfg>
 __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh, float* frame) {
-  if (render_by_warps(ParamsOf<Cfg>::visual())) {
-    for (int32_t first = static_cast<int32_t>(blockIdx.x) * kWarpsPerBlock; first < e.num_envs;
-         first += static_cast<int32_t>(gridDim.x) * kWarpsPerBlock) {
-      const int32_t last = first + kWarpsPerBlock < e.num_envs ? first + kWarpsPerBlock : e.num_envs;
-      for (int32_t env = first; env < last; ++env) {
-        group_copy_words<BlockGroup>(&sh.latent, e.latent + env, static_cast<int32_t>(sizeof(LatentState)));
-        group_copy_words<BlockGroup>(&sh.visual, e.visual + env, e.visual_extent);
-        __syncthreads();
-        render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
-                                      frame_of<Cfg>(e, env));
-        __syncthreads();
-      }
+  const int32_t k = frames_per_block(ParamsOf<Cfg>::visual());
+  for (int32_t first = static_cast<int32_t>(blockIdx.x) * k; first < e.num_envs;
+       first += static_cast<int32_t>(gridDim.x) * k) {
+    const int32_t last = first + k < e.num_envs ? first + k : e.num_envs;
+    for (int32_t env = first; env < last; ++env) {
+      group_copy_words<BlockGroup>(&sh.latent, e.latent + env, static_cast<int32_t>(sizeof(LatentState)));
+      group_copy_words<BlockGroup>(&sh.visual, e.visual + env, e.visual_extent);
+      __syncthreads();
+      render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
+                                    frame_of<Cfg>(e, env));
+      __syncthreads();
     }
-    return;
-  }
-  for (int32_t env = static_cast<int32_t>(blockIdx.x); env < e.num_envs; env += static_cast<int32_t>(gridDim.x)) {
-    load_state<Cfg>(e, env, sh);
-    render_frame<Cfg, BlockGroup>(e, env, sh, sh.segments, frame, frame_of<Cfg>(e, env));
-    __syncthreads();
   }
 }
 
@@ -224,18 +155,12 @@ __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n,
 }  // namespace kage
 
 /// Emits the entry points of one config with fixed unmangled names, so that a loader finds them in any
-/// compiled config: kage_reset and kage_step_only (one thread per environment; any block size),
-/// kage_step_render and kage_render (one block per environment, render_threads() threads and
-/// render_dynamic_smem_bytes() bytes of dynamic shared memory), kage_sample_actions. Use once per module.
+/// compiled config: kage_reset and kage_step (one thread per environment; any block size),
+/// kage_render (render_threads() threads and render_dynamic_smem_bytes() bytes of dynamic shared memory
+/// per block, frames_per_block() environments per block), kage_sample_actions. Use once per module.
 #define KAGE_INSTANTIATE_KERNELS(CFG)                                                                     \
   extern "C" __global__ void kage_reset(const kage::DeviceEnvs e) { kage::reset_body<CFG>(e); }           \
-  extern "C" __global__ void kage_step_only(const kage::DeviceEnvs e) { kage::step_only_body<CFG>(e); }   \
-  extern "C" __global__ void __launch_bounds__(kage::RenderBounds<CFG>::kThreads,                          \
-                                               kage::RenderBounds<CFG>::kMinBlocks) kage_step_render(const kage::DeviceEnvs e) {         \
-    __shared__ kage::BlockShared sh;                                                                      \
-    extern __shared__ float4 kage_frame[];                                                                \
-    kage::step_render_body<CFG>(e, sh, reinterpret_cast<float*>(kage_frame));                             \
-  }                                                                                                       \
+  extern "C" __global__ void kage_step(const kage::DeviceEnvs e) { kage::step_body<CFG>(e); }   \
   extern "C" __global__ void __launch_bounds__(kage::RenderBounds<CFG>::kThreads,                          \
                                                kage::RenderBounds<CFG>::kMinBlocks) kage_render(const kage::DeviceEnvs e) {              \
     __shared__ kage::BlockShared sh;                                                                      \

@@ -1,6 +1,6 @@
-// Register path of the GPU renderer: the per-frame values (FrameSetup), the layout's column table and
-// the 16-pixel runs that a thread composes, filters and lights in registers. Used by kernels.cuh with
-// a whole block (BlockGroup) or one warp (WarpGroup) per frame.
+// Register path of the GPU renderer: frames without neighbourhood filters, composed, filtered and lit
+// in registers by the threads of a block (BlockGroup): plain frames as 16-byte words, others as
+// 16-pixel runs per thread.
 #pragma once
 
 #include "runtime/cuda/kernel_step.cuh"
@@ -11,7 +11,7 @@
 
 namespace kage {
 
-/// A layout mask that is the same everywhere: composes the two colours of a plain run.
+/// A layout mask that is the same everywhere: composes the two colours of a plain frame.
 struct ConstSolid {
   bool value;
   __device__ __forceinline__ bool operator()(int32_t, int32_t) const { return value; }
@@ -33,21 +33,11 @@ struct SpanSolid {
 constexpr short kShortMax = 32767;
 constexpr short kShortMin = -32768;
 
-/// The threads that render one frame together: a whole block (frame-pass path, wide frames) or one
-/// warp (register path: eight independent frames per 256-thread block, so that one lane's serial step
-/// and frame setup overlap the other warps' pixels instead of stalling a whole block).
+/// The threads that render one frame together: the whole block.
 struct BlockGroup {
-  static constexpr bool kWholeBlock = true;
   __device__ __forceinline__ static int32_t rank() { return static_cast<int32_t>(threadIdx.x); }
   __device__ __forceinline__ static int32_t size() { return static_cast<int32_t>(blockDim.x); }
   __device__ __forceinline__ static void sync() { __syncthreads(); }
-};
-struct WarpGroup {
-  static constexpr bool kWholeBlock = false;
-  __device__ __forceinline__ static int32_t rank() { return static_cast<int32_t>(threadIdx.x % 32); }
-  __device__ __forceinline__ static int32_t size() { return 32; }
-  // __syncwarp also orders the lanes' shared and global memory accesses (the step's writes).
-  __device__ __forceinline__ static void sync() { __syncwarp(); }
 };
 
 /// Copies `bytes` (a multiple of 4) between two 4-byte aligned buffers with the threads of `Group`.
@@ -100,63 +90,106 @@ __device__ __forceinline__ void pack_quad(uint32_t a, uint32_t b, uint32_t c, ui
   w[2] = (c >> 16) | (d << 8);
 }
 
-/// The pixel (r, c) of a plain run (outside the agent box) with the layout mask fixed to `solid`.
-template <class Cfg, class Slot>
-__device__ __forceinline__ uint32_t plain_pixel(const AssetView& assets, const Slot& sh, bool solid, int32_t r,
-                                                int32_t c) {
-  uint8_t rgb[3];
-  register_pixel<Cfg>(assets, sh, ConstSolid{solid}, r, c, rgb);
-  return pack_rgb(rgb);
+/// The three words of a 12-byte repeat of pixel p (r | g << 8 | b << 16): bytes whose offset is
+/// 0, 1 and 2 mod 3 start them.
+struct PixelPattern {
+  uint32_t w[3];
+  __device__ __forceinline__ explicit PixelPattern(uint32_t p)
+      : w{p | (p << 24), (p >> 8) | (p << 16), (p >> 16) | (p << 8)} {}
+  /// The 16 bytes of a row of p starting at a byte offset that is `phase` mod 3 (4 = 1 mod 3).
+  __device__ __forceinline__ uint4 word(int32_t phase) const {
+    const uint32_t a = phase == 0 ? w[0] : phase == 1 ? w[1] : w[2];
+    const uint32_t b = phase == 0 ? w[1] : phase == 1 ? w[2] : w[0];
+    const uint32_t c = phase == 0 ? w[2] : phase == 1 ? w[0] : w[1];
+    return make_uint4(a, b, c, a);
+  }
+};
+
+/// The 16 bytes starting `skip` (0..2) bytes into six consecutive packed pixels.
+__device__ __forceinline__ uint4 six_pixels_word(const uint32_t* px, int32_t skip) {
+  uint32_t q[5];
+  pack_quad(px[0], px[1], px[2], px[3], q);
+  q[3] = px[4] | (px[5] << 24);
+  q[4] = px[5] >> 8;
+  const uint32_t shift = 8u * static_cast<uint32_t>(skip);
+  return make_uint4(__funnelshift_r(q[0], q[1], shift), __funnelshift_r(q[1], q[2], shift),
+                    __funnelshift_r(q[2], q[3], shift), __funnelshift_r(q[3], q[4], shift));
 }
 
-/// Register path: each thread renders runs of 16 pixels of one row and stores each as three 16-byte
-/// words (rows whose width is not a multiple of 16 are stored byte by byte). A plain run (nothing but
-/// the background and the layout, see compose_layout_only) composes one pixel per layout colour and
-/// selects per pixel through the column spans, or, when the group's span extremes show that the row
-/// is all solid or all empty, stores one colour; this takes simplest from ~75 instructions per pixel
-/// to a few. Other runs compose every pixel: four at a time into three words where the chain is
-/// specialized, one at a time in the generic build (its chain inlined four times under the register
-/// cap was 4x slower on hardest without neighbourhood filters: 93 k -> 23.5 k steps/s).
+/// A plain frame (FrameSetup::plain; rows a multiple of 16 pixels): the scene is one of two colours at
+/// every pixel outside the agent box, chosen by the layout mask. Pass 1 writes the whole frame as
+/// 16-byte words, consecutive threads on consecutive words (every warp store covers 512 contiguous
+/// bytes): word j of a row lies in the 16-column group j / 3 at byte phase j % 3, and is one colour
+/// when the group's span extremes say so, else six masked pixels. Pass 2 composes the agent box one
+/// pixel per thread and overwrites it, so the agent's few hundred pixels are spread over the group
+/// instead of serialising the threads whose words it touches.
+template <class Cfg, class Group, class Slot>
+__device__ __forceinline__ void render_plain_frame(const AssetView& assets, const Slot& sh, const SpanSolid& solid,
+                                                   uint8_t* out) {
+  const VisualParams& vp = ParamsOf<Cfg>::visual();
+  const FrameSetup& fs = sh.setup;
+  uint8_t rgb[3];
+  scene_pixel(vp, assets, fs.agent, ConstSolid{true}, sh.visual, fs.f, 0, 0, rgb);
+  const uint32_t on = pack_rgb(rgb);
+  scene_pixel(vp, assets, fs.agent, ConstSolid{false}, sh.visual, fs.f, 0, 0, rgb);
+  const uint32_t off = pack_rgb(rgb);
+  const PixelPattern on_words(on), off_words(off);
+  const int32_t words_per_row = vp.W * 3 / 16;
+  uint4* words = reinterpret_cast<uint4*>(out);
+  for (int32_t k = Group::rank(); k < vp.H * words_per_row; k += Group::size()) {
+    const int32_t r = k / words_per_row;
+    const int32_t j = k - r * words_per_row;
+    const int32_t g = j / 3;
+    const int32_t phase = j - 3 * g;
+    const GroupSpan gs = sh.groups[g];
+    const int32_t rr = clampi(r, 0, solid.height_px - 1);
+    if (rr < gs.lo_min || rr >= gs.hi_max) {
+      words[k] = off_words.word(phase);
+    } else if (rr >= gs.lo_max && rr < gs.hi_min) {
+      words[k] = on_words.word(phase);
+    } else {
+      // Bytes 16 * phase .. + 15 of the group's 48 start `phase` bytes into its pixel 5 * phase.
+      const int32_t c0 = g * kPixelsPerThread + 5 * phase;
+      uint32_t px[6];
+#pragma unroll
+      for (int32_t t = 0; t < 6; ++t) px[t] = solid(r, c0 + t + solid.cam) ? on : off;
+      words[k] = six_pixels_word(px, phase);
+    }
+  }
+  Group::sync();
+  const ScreenBox& box = fs.agent_box;
+  const int32_t x0 = maxi(box.x0, 0), x1 = mini(box.x1, vp.W - 1);
+  const int32_t y0 = maxi(box.y0, 0), y1 = mini(box.y1, vp.H - 1);
+  const int32_t box_w = x1 - x0 + 1;
+  if (box_w <= 0 || y1 < y0) return;
+  for (int32_t i = Group::rank(); i < box_w * (y1 - y0 + 1); i += Group::size()) {
+    const int32_t r = y0 + i / box_w;
+    const int32_t c = x0 + i % box_w;
+    register_pixel<Cfg>(assets, sh, solid, r, c, rgb);
+    uint8_t* dst = out + (r * vp.W + c) * 3;
+    dst[0] = rgb[0];
+    dst[1] = rgb[1];
+    dst[2] = rgb[2];
+  }
+}
+
+/// Register path: a plain frame by render_plain_frame; otherwise each thread composes runs of 16
+/// pixels of one row and stores each run as three 16-byte words (rows whose width is not a multiple of
+/// 16 are stored byte by byte): four pixels at a time into three words where the chain is specialized,
+/// one at a time in the generic build (its chain inlined four times under the register cap was 4x
+/// slower on hardest without neighbourhood filters: 93 k -> 23.5 k steps/s).
 template <class Cfg, class Group, class Slot>
 __device__ __forceinline__ void render_register_path(const AssetView& assets, const Slot& sh,
                                                      const SpanSolid& solid, uint8_t* out) {
   const VisualParams& vp = ParamsOf<Cfg>::visual();
   if (register_path_vectorized(vp)) {
-    const FrameSetup& fs = sh.setup;
-    const bool plain = fs.plain;
-    const ScreenBox box = fs.agent_box;
+    if (sh.setup.plain) return render_plain_frame<Cfg, Group>(assets, sh, solid, out);
     const int32_t runs_per_row = vp.W / kPixelsPerThread;
     for (int32_t run = Group::rank(); run < vp.H * runs_per_row; run += Group::size()) {
       const int32_t r = run / runs_per_row;
-      const int32_t g = run - r * runs_per_row;
-      const int32_t c0 = g * kPixelsPerThread;
+      const int32_t c0 = (run - r * runs_per_row) * kPixelsPerThread;
       uint8_t* dst = out + (r * vp.W + c0) * 3;
-      const bool agent_run = r >= box.y0 && r <= box.y1 && c0 <= box.x1 && c0 + kPixelsPerThread - 1 >= box.x0;
-      if (plain && !agent_run) {
-        const GroupSpan gs = sh.groups[g];
-        const int32_t rr = clampi(r, 0, solid.height_px - 1);
-        const bool none = rr < gs.lo_min || rr >= gs.hi_max;
-        const bool all = rr >= gs.lo_max && rr < gs.hi_min;
-        uint32_t w[12];
-        if (none || all) {
-          const uint32_t p = plain_pixel<Cfg>(assets, sh, all, r, c0);
-          pack_quad(p, p, p, p, w);
-#pragma unroll
-          for (int32_t q = 1; q < 4; ++q) w[3 * q] = w[0], w[3 * q + 1] = w[1], w[3 * q + 2] = w[2];
-        } else {
-          const uint32_t on = plain_pixel<Cfg>(assets, sh, true, r, c0);
-          const uint32_t off = plain_pixel<Cfg>(assets, sh, false, r, c0);
-          uint32_t px[kPixelsPerThread];
-#pragma unroll
-          for (int32_t j = 0; j < kPixelsPerThread; ++j) px[j] = solid(r, c0 + j + solid.cam) ? on : off;
-#pragma unroll
-          for (int32_t q = 0; q < 4; ++q) pack_quad(px[4 * q], px[4 * q + 1], px[4 * q + 2], px[4 * q + 3], w + 3 * q);
-        }
-        uint4* d4 = reinterpret_cast<uint4*>(dst);
-        d4[0] = make_uint4(w[0], w[1], w[2], w[3]);
-        d4[1] = make_uint4(w[4], w[5], w[6], w[7]);
-        d4[2] = make_uint4(w[8], w[9], w[10], w[11]);
-      } else if constexpr (kGenericBuild<Cfg>) {
+      if constexpr (kGenericBuild<Cfg>) {
 #pragma unroll 1
         for (int32_t j = 0; j < kPixelsPerThread; ++j) {
           uint8_t rgb[3];

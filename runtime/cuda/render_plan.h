@@ -14,25 +14,21 @@
 
 namespace kage {
 
-/// Capacities of a rendering block's shared state (BlockShared below): layout bytes and screen
-/// columns. DeviceBatch rejects configs beyond them.
-constexpr int32_t kMaxLayoutBytes = 4096;
+/// Capacity of a rendering block's column table (BlockShared below): screen columns. DeviceBatch
+/// rejects configs beyond it.
 constexpr int32_t kMaxScreenWidth = 1024;
 
-/// Pixels per thread: one 48-byte run of a row (three 16-byte stores) in the register path, a
-/// strided set of 16 pixels in the frame-pass path.
+/// Pixels of a 48-byte run of a row (three 16-byte words) in the register path.
 constexpr int32_t kPixelsPerThread = 16;
-/// Threads of a register-path block (one frame per block, or one per warp: render_by_warps).
+/// Threads of a register-path block, and the frames it renders one after the other.
 constexpr int32_t kRegisterPathThreads = 256;
+constexpr int32_t kRegisterPathFramesPerBlock = 8;
 /// Pixels per thread of the frame-pass path (strided), and its largest block: every pixel of the frame
 /// belongs to one of its threads. 512 threads of 32 pixels rather than 1024 of 16: the register cap
 /// of a 512-thread block is 128 instead of 64 (the 1024-thread kernel spilled 2.2 KB per thread), and
 /// the banded passes keep only two pixels' results in registers whatever the pixel count.
 constexpr int32_t kFramePassPixelsPerThread = 32;
 constexpr int32_t kFramePassMaxThreads = 512;
-/// Widest frame a warp renders alone (the width of its column table in shared memory).
-constexpr int32_t kWarpPathMaxWidth = 256;
-constexpr int32_t kWarpsPerBlock = kRegisterPathThreads / 32;
 
 /// Solid rows [lo, hi) of one screen column, packed as two 16-bit values.
 struct ColumnSpan {
@@ -62,19 +58,8 @@ struct BlockShared {
   LatentState latent;
   FrameSetup setup;
   alignas(16) VisualState visual;
-  alignas(16) uint8_t segments[kMaxLayoutBytes];
   ColumnSpan spans[kMaxScreenWidth];
   GroupSpan groups[kMaxScreenWidth / kPixelsPerThread];
-};
-
-/// One warp's frame in the dynamic shared memory of a warp-path block: as BlockShared
-/// without the layout, which the warp reads from global memory (only its column table is per pixel).
-struct WarpSlot {
-  LatentState latent;
-  FrameSetup setup;
-  alignas(16) VisualState visual;
-  ColumnSpan spans[kWarpPathMaxWidth];
-  GroupSpan groups[kWarpPathMaxWidth / kPixelsPerThread];
 };
 
 /// Whether any frame pass can run: a sharpening preset in pop_filter_list or pop_filter, blur,
@@ -90,12 +75,8 @@ KAGE_HD bool needs_frame_passes(const VisualParams& p) {
 /// Whether the register path can store whole 16-pixel runs (each row a multiple of 16 pixels).
 KAGE_HD bool register_path_vectorized(const VisualParams& p) { return p.W % kPixelsPerThread == 0; }
 
-/// Whether each warp renders its own frame (register path, frame at most kWarpPathMaxWidth wide):
-/// a block renders kWarpsPerBlock frames at once from WarpSlots in dynamic shared memory.
-KAGE_HD bool render_by_warps(const VisualParams& p) { return !needs_frame_passes(p) && p.W <= kWarpPathMaxWidth; }
-
-/// Frames a rendering block renders at once.
-KAGE_HD int32_t frames_per_block(const VisualParams& p) { return render_by_warps(p) ? kWarpsPerBlock : 1; }
+/// Frames a rendering block renders, one after the other.
+KAGE_HD int32_t frames_per_block(const VisualParams& p) { return needs_frame_passes(p) ? 1 : kRegisterPathFramesPerBlock; }
 
 /// Threads per rendering block.
 KAGE_HD int32_t render_threads(const VisualParams& p) {
@@ -104,11 +85,10 @@ KAGE_HD int32_t render_threads(const VisualParams& p) {
   return (per + 31) / 32 * 32;
 }
 
-/// Dynamic shared memory of a rendering block: the float32 frame of the frame-pass path, the warps'
-/// slots of the warp path; a block-wide register path packs its pixels in registers and needs none.
+/// Dynamic shared memory of a rendering block: the float32 frame of the frame-pass path; the register
+/// path packs its pixels in registers and needs none.
 KAGE_HD int32_t render_dynamic_smem_bytes(const VisualParams& p) {
-  if (needs_frame_passes(p)) return p.H * p.W * 3 * static_cast<int32_t>(sizeof(float));
-  return render_by_warps(p) ? kWarpsPerBlock * static_cast<int32_t>(sizeof(WarpSlot)) : 0;
+  return needs_frame_passes(p) ? p.H * p.W * 3 * static_cast<int32_t>(sizeof(float)) : 0;
 }
 
 /// Whether the GPU kernels support this frame size: the frame-pass path holds one frame per block.

@@ -166,7 +166,7 @@ struct ScreenBox {
   int32_t x0, x1, y0, y1;
 };
 
-/// The box of agent_pixel's three cases: the sprite frame, the shape's test box, the rectangle.
+/// The box of agent_pixel's three cases: the sprite frame, the shape's reach, the rectangle.
 KAGE_HD ScreenBox agent_box(const VisualParams& p, const AssetView& assets, const VisualState& s,
                             const FrameConstants& f) {
   if (p.use_sprites) {
@@ -176,7 +176,8 @@ KAGE_HD ScreenBox agent_box(const VisualParams& p, const AssetView& assets, cons
     return ScreenBox{x0, x0 + fr.width - 1, y0, y0 + fr.height - 1};
   }
   if (p.use_shape) {
-    const int32_t e = maxi(p.char_width, p.char_height);
+    const ShapeType type = p.shape_types[clampi(s.shape_type_idx, 0, p.shape_type_count - 1)];
+    const int32_t e = agent_shape_reach(type, p.char_width, p.char_height);
     return ScreenBox{f.agent_cx - e, f.agent_cx + e, f.agent_cy - e, f.agent_cy + e};
   }
   return ScreenBox{f.agent_cx - p.hw, f.agent_cx + p.hw, f.agent_cy - p.hh, f.agent_cy + p.hh};
@@ -192,16 +193,24 @@ KAGE_HD bool compose_layout_only(const VisualParams& p, const AssetView& assets)
          !(p.sticky_enabled && assets.sticky_types.count > 0);
 }
 
-/// The composited scene at pixel (r, c) before filters (spec 6.1 steps 1-7). `solid(r, wc)` is the
-/// layout's mask at screen row r and world column wc; it clamps both like the original's gathers (6.3).
+/// The scene under the agent at pixel (r, c) (spec 6.1 steps 1-6): background, distractors, layout,
+/// NPCs. `solid(r, wc)` is the layout's mask at screen row r and world column wc; it clamps both like
+/// the original's gathers (6.3).
 template <class SolidFn>
-KAGE_HD void compose_pixel(const VisualParams& p, const AssetView& assets, const AgentView& agent, const SolidFn& solid,
-                           const VisualState& s, const FrameConstants& f, int32_t r, int32_t c, uint8_t* rgb) {
+KAGE_HD void scene_pixel(const VisualParams& p, const AssetView& assets, const AgentView& agent, const SolidFn& solid,
+                         const VisualState& s, const FrameConstants& f, int32_t r, int32_t c, uint8_t* rgb) {
   background_pixel(p, assets, s, agent.camera_x, r, c, rgb);
   distractors_pixel(p, s, f, r, c, rgb);
   if (solid(r, c + f.cam)) set_rgb(rgb, p.layout_colors[clampi(s.layout_color_idx, 0, p.layout_color_count - 1)]);
   if (p.npc_enabled && assets.npc_types.count > 0) npcs_pixel(p, assets, s, f, r, c, rgb);
   if (p.sticky_enabled && assets.sticky_types.count > 0) sticky_pixel(p, assets, s, f, r, c, rgb);
+}
+
+/// The composited scene at pixel (r, c) before filters (spec 6.1 steps 1-7).
+template <class SolidFn>
+KAGE_HD void compose_pixel(const VisualParams& p, const AssetView& assets, const AgentView& agent, const SolidFn& solid,
+                           const VisualState& s, const FrameConstants& f, int32_t r, int32_t c, uint8_t* rgb) {
+  scene_pixel(p, assets, agent, solid, s, f, r, c, rgb);
   agent_pixel(p, assets, s, f, r, c, rgb);
 }
 

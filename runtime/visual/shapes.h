@@ -113,6 +113,23 @@ KAGE_HD bool inside_agent_shape(ShapeType type, int32_t cx, int32_t cy, int32_t 
   }
 }
 
+/// How far (in whole pixels along each axis) inside_agent_shape can be true from the centre at any
+/// angle: the circle reaches R = min(w, h) / 2, the ellipse max(w, h) / 2, the other shapes at most the
+/// rotated square's corner R * sqrt(2) (polygon vertices lie at R from the half-pixel centre). One
+/// pixel of margin each; never more than agent_pixel's own max(w, h) test box.
+KAGE_HD int32_t agent_shape_reach(ShapeType type, int32_t w, int32_t h) {
+  const int32_t e = maxi(w, h);
+  const float R = 0.5f * static_cast<float>(mini(w, h));
+  switch (type) {
+    case ShapeType::kCircle:
+      return mini(e, static_cast<int32_t>(R) + 1);
+    case ShapeType::kEllipse:
+      return mini(e, e / 2 + 1);
+    default:
+      return mini(e, static_cast<int32_t>(R * 1.4143f) + 2);
+  }
+}
+
 /// Whether pixel (c, r) is inside a distractor of size s centred at (cx, cy) (spec 9.4; the 32 x 32
 /// window is the caller's); sf = shape_frame(type, cx, cy, s / 2, angle used as radians).
 KAGE_HD bool inside_distractor(ShapeType type, int32_t cx, int32_t cy, float s, const ShapeFrame& sf, int32_t c,
