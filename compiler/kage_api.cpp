@@ -4,6 +4,7 @@
 
 #include <dlfcn.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -51,6 +52,12 @@ const float* info_column(const BatchInfo& info, InfoField field) {
   return nullptr;
 }
 
+/// The CPU backends' copy_obs: their observations are host memory already.
+void copy_host_obs(const Env& env, uint8_t* dst) {
+  const size_t bytes = static_cast<size_t>(env.num_envs()) * env.height() * env.width() * 3;
+  std::memcpy(dst, env.obs(), bytes);
+}
+
 /// A lowered config with its Spec hash, from a YAML file or a compiled dir's params.bin.
 struct Loaded {
   std::string spec_hash;
@@ -94,6 +101,7 @@ class GenericCpuEnv final : public Env {
   const uint8_t* terminated() const override { return env_->env().info().terminated.data(); }
   const uint8_t* truncated() const override { return env_->env().info().truncated.data(); }
   const float* info(InfoField f) const override { return info_column(env_->env().info(), f); }
+  bool copy_obs(uint8_t* dst, std::string*) const override { return copy_host_obs(*this, dst), true; }
 
  private:
   std::unique_ptr<Environment> env_;
@@ -118,6 +126,7 @@ class GeneratedCpuEnv final : public Env {
   const uint8_t* terminated() const override { return batch_.info().terminated.data(); }
   const uint8_t* truncated() const override { return batch_.info().truncated.data(); }
   const float* info(InfoField f) const override { return info_column(batch_.info(), f); }
+  bool copy_obs(uint8_t* dst, std::string*) const override { return copy_host_obs(*this, dst), true; }
 
  private:
   void* lib_;
@@ -173,6 +182,7 @@ class GpuEnv final : public Env {
   const uint8_t* terminated() const override { return reinterpret_cast<const uint8_t*>(batch_.terminated()); }
   const uint8_t* truncated() const override { return reinterpret_cast<const uint8_t*>(batch_.truncated()); }
   const float* info(InfoField) const override { return nullptr; }
+  bool copy_obs(uint8_t* dst, std::string* e) const override { return batch_.download_obs(dst, e); }
 
  private:
   CudaModule module_;

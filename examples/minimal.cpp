@@ -28,21 +28,19 @@ int main(int argc, char** argv) {
   double total = 0;
   for (int t = 0; t < 100; ++t) {
     if (!env->step(actions.data(), &error)) return std::fprintf(stderr, "%s\n", error.c_str()), 1;
+    // Rewards and info are host arrays on the CPU backend, device arrays on the GPU backend.
     if (env->backend() == kage::Backend::kCpu) {
       for (int32_t i = 0; i < env->num_envs(); ++i) total += env->reward()[i];
     }
   }
-  if (env->backend() == kage::Backend::kCpu) {
-    // FNV-1a over every observation byte (host memory on the CPU backend).
-    uint64_t h = 1469598103934665603ull;
-    const size_t bytes = static_cast<size_t>(env->num_envs()) * env->height() * env->width() * 3;
-    for (size_t i = 0; i < bytes; ++i) h = (h ^ env->obs()[i]) * 1099511628211ull;
-    std::printf("spec %.16s  envs %d  %dx%d  total reward %.4f  x[0] %.1f  obs fnv1a %016llx\n",
-                env->spec_hash().c_str(), env->num_envs(), env->height(), env->width(), total,
-                env->info(kage::InfoField::kX)[0], static_cast<unsigned long long>(h));
-  } else {
-    std::printf("spec %.16s  envs %d  %dx%d  (outputs in device memory)\n", env->spec_hash().c_str(),
-                env->num_envs(), env->height(), env->width());
-  }
+  // FNV-1a over every observation byte, copied to the host on either backend.
+  std::vector<uint8_t> obs(static_cast<size_t>(env->num_envs()) * env->height() * env->width() * 3);
+  if (!env->copy_obs(obs.data(), &error)) return std::fprintf(stderr, "%s\n", error.c_str()), 1;
+  uint64_t h = 1469598103934665603ull;
+  for (uint8_t byte : obs) h = (h ^ byte) * 1099511628211ull;
+  std::printf("spec %.16s  envs %d  %dx%d  obs fnv1a %016llx\n", env->spec_hash().c_str(), env->num_envs(),
+              env->height(), env->width(), static_cast<unsigned long long>(h));
+  if (env->backend() == kage::Backend::kCpu)
+    std::printf("total reward %.4f  x[0] %.1f\n", total, env->info(kage::InfoField::kX)[0]);
   return 0;
 }

@@ -61,6 +61,9 @@ class Env {
   virtual const uint8_t* truncated() const = 0;   ///< [N] 0/1
   /// CPU: [N] floats of one info field. GPU: null (read the StepInfo array of runtime/cuda instead).
   virtual const float* info(InfoField field) const = 0;
+  /// Copies the observations of the last reset or step (num_envs() * height() * width() * 3 bytes)
+  /// into host memory `dst`, on either backend.
+  [[nodiscard]] virtual bool copy_obs(uint8_t* dst, std::string* error = nullptr) const = 0;
 };
 
 /// Opens `path`: a directory with manifest.json (from `kagec compile`) or a YAML config. Null on error.
