@@ -1,6 +1,6 @@
 // kage_gpu_bench: correctness (GPU vs CPU reference), load times and throughput of the CUDA runtime
 // for configs compiled by `kagec compile`, against a device-to-device copy roofline measured in the
-// same run.
+// same run, and the device's FP32 rate (fp32_peak.fatbin beside GENERIC_FATBIN).
 //
 // Usage: kage_gpu_bench GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] [--check-envs N]
 //                       [--nvrtc-root DIR] [--breakdown] [--skip-checks] [--check-only]
@@ -291,8 +291,12 @@ int run(int argc, char** argv) {
   std::fflush(stdout);
 
   const double roof = measure_roofline();
-  std::printf("\n## Roofline\n\ndevice-to-device copy: %.1f GB/s (read + write) = %.1f M frames/s of 128x128x3\n\n",
-              roof, roof * 1e9 / 49152.0 / 1e6);
+  // The FP32 kernel sits beside the generic kernels (bench/CMakeLists.txt).
+  const CudaModule fp32 = load((std::filesystem::path(argv[1]).parent_path() / "fp32_peak.fatbin").string());
+  const double fp32_gflops = measure_fp32_rate(fp32);
+  std::printf("\n## Roofline\n\ndevice-to-device copy: %.1f GB/s (read + write) = %.1f M frames/s of 128x128x3\n"
+              "FP32 (chains of fused multiply-adds, 2 FLOPs each): %.1f TFLOP/s\n\n",
+              roof, roof * 1e9 / 49152.0 / 1e6, fp32_gflops / 1e3);
   std::printf("## Throughput\n\n| config | envs | steps/s with obs | obs GB/s | %% of roofline | steps/s state only |\n"
               "|---|---|---|---|---|---|\n");
   for (const Config& c : cfgs) {
@@ -314,7 +318,11 @@ int run(int argc, char** argv) {
       std::printf("| %s | %.3g |\n", label.c_str(), time_config(c, 1 << 14, true, false).render_steps_per_s);
       std::fflush(stdout);
     }
-    std::printf("| hardest, specialized build | %.3g |\n", time_config(*hardest, 1 << 14, true, false).render_steps_per_s);
+    const double rate = time_config(*hardest, 1 << 14, true, false).render_steps_per_s;
+    std::printf("| hardest, specialized build | %.3g |\n\nAt %.3g frames/s the measured FP32 rate leaves %.0f FP32 "
+                "operations per pixel; 2 M frames/s would leave %.0f.\n",
+                rate, rate, fp32_gflops * 1e9 / rate / (hardest->vp.H * hardest->vp.W),
+                fp32_gflops * 1e9 / 2e6 / (hardest->vp.H * hardest->vp.W));
   }
   std::printf("\n%s\n", all_ok ? "all checks passed" : "SOME CHECKS FAILED");
   return all_ok ? 0 : 1;

@@ -59,6 +59,26 @@ double measure_roofline() {
   return 2.0 * static_cast<double>(bytes) / (ms * 1e-3) / 1e9;
 }
 
+double measure_fp32_rate(const CudaModule& module) {
+  std::string error;
+  CUfunction f = module.function("kage_fp32_peak", &error);
+  if (!f) throw MeasureError(error);
+  constexpr int32_t kThreads = 256, kBlocks = 8192, kIterations = 4096, kChains = 8;
+  CUdeviceptr out;
+  cu_or_throw(cuMemAlloc(&out, sizeof(float) * kThreads * kBlocks), "cuMemAlloc(fp32)");
+  int32_t iterations = kIterations;
+  float seed = 1.0f;
+  void* args[] = {&out, &iterations, &seed};
+  auto launch = [&] {
+    cu_or_throw(cuLaunchKernel(f, kBlocks, 1, 1, kThreads, 1, 1, 0, nullptr, args, nullptr), "cuLaunchKernel(fp32)");
+  };
+  launch();
+  const double ms = median_ms(launch);
+  cu_or_throw(cuMemFree(out), "cuMemFree");
+  const double flops = 2.0 * kChains * static_cast<double>(kIterations) * kThreads * kBlocks;
+  return flops / (ms * 1e-3) / 1e9;
+}
+
 Timing time_config(const MeasureTarget& c, int32_t n, bool render, bool state_too) {
   std::string error;
   std::optional<DeviceBatch> b = DeviceBatch::create(*c.module, c.lp, c.vp, c.assets, n, &error);

@@ -26,6 +26,10 @@ double median_ms(const std::function<void()>& run_once);
 /// Device-to-device copy bandwidth in GB/s (bytes read + written), 4 GiB each way.
 double measure_roofline();
 
+/// The FP32 rate in GFLOP/s (fused multiply-adds counted as 2), from kage_fp32_peak of `module`
+/// (bench/modules/fp32_peak.cu) on a grid that fills the device.
+double measure_fp32_rate(const CudaModule& module);
+
 /// What one batch of one config is run with.
 struct MeasureTarget {
   const CudaModule* module;
