@@ -113,7 +113,7 @@ class Converter {
         break;
       case YAML::NodeType::Scalar:
         out.kind = DocNode::Kind::Scalar;
-        out.text = n.Scalar();
+        out.text = utf8_from_latin1_strays(n.Scalar());
         out.quoted = n.Tag() == "!" || n.Tag() == "tag:yaml.org,2002:str";
         out.range.end = scalar_end(begin, out.text, out.quoted);
         break;
@@ -129,7 +129,7 @@ class Converter {
         for (auto it = n.begin(); it != n.end(); ++it) {
           DocEntry e;
           const uint32_t kb = offset_of(it->first, begin);
-          e.key = it->first.IsScalar() ? it->first.Scalar() : std::string("?");
+          e.key = it->first.IsScalar() ? utf8_from_latin1_strays(it->first.Scalar()) : std::string("?");
           e.key_range = Range{Loc{file_, kb}, kb + static_cast<uint32_t>(e.key.size())};
           e.value = convert(it->second, e.key_range.end, pointer + "/" + e.key);
           if (e.value.is_null()) e.value.range = Range{Loc{file_, e.key_range.begin.offset}, e.key_range.end};

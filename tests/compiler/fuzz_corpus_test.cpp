@@ -33,6 +33,9 @@ std::vector<std::string> seed_corpus() {
   out.push_back("\xEF\xBB\xBF" "H: 64\n");
   // Multi-byte characters where a string is read as a list of its characters.
   out.push_back("background: {mode: color, color_names: \"b\xDE\x96\"}\nfilters: {pop_filter_list: \"\xE2\x82\xAC\"}\n");
+  // YAML escapes that yaml-cpp writes as single Latin-1 bytes.
+  out.push_back("background: {mode: black, image_paths: [\"a\\Nb\\_c.png\"]}\n");
+  out.push_back("\"\\N\": 1\n");
   return out;
 }
 
