@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "compiler/key_refs.h"
+#include "compiler/utf8.h"
 #include "runtime/host/asset_scan.h"
 #include "runtime/host/sha256.h"
 
@@ -94,7 +95,18 @@ class AssetResolver {
     return range_of(path);
   }
 
+  // The canonical Spec is JSON, which holds only UTF-8: a file or folder whose name is not is refused.
+  bool utf8_name(const std::string& path, Range at, const std::string& key) {
+    if (!invalid_utf8_offset(path)) return true;
+    diags_.report(Rule::AssetUnreadable, at,
+                  "asset path '" + utf8_from_latin1_strays(path) + "' (from '" + key +
+                      "') is not valid UTF-8; rename the file or folder",
+                  pointer_of(key));
+    return false;
+  }
+
   std::optional<AssetFile> hash_image(const std::string& file, Range at, const std::string& key) {
+    if (!utf8_name(file, at, key)) return std::nullopt;
     std::error_code ec;
     std::ifstream in;
     // Only regular files: a directory or a device such as /dev/zero named as an image is not one.
@@ -192,6 +204,7 @@ class AssetResolver {
     }
     std::vector<AssetSet>& sets = *spec_.assets.sets(g.name);
     for (const auto& [dir, at, key] : dirs) {
+      if (!utf8_name(dir, at, key)) continue;
       std::error_code ec;
       if (!fs::is_directory(dir, ec)) {
         diags_.report(Rule::AssetMissing, at, "sprite folder '" + dir + "' does not exist; fix the path",

@@ -96,6 +96,22 @@ TEST_CASE("configs in different directories naming the same asset resolve identi
   CHECK(a.spec->assets.backgrounds[0].width > 0);
 }
 
+TEST_CASE("an asset file or sprite folder whose name is not UTF-8 is an error, not a crash", "[resolve][assets]") {
+  TempDir tmp("non_utf8_asset");
+  write_text(tmp.path() / "bgs" / "bad\xFF.png", "not read: the name is refused first");
+  fs::create_directories(tmp.path() / "skins" / "skin\xFE");
+  write_text(tmp.path() / "c.yaml",
+             "background: {mode: image, image_dir: bgs}\n"
+             "character: {use_shape: false, use_sprites: true, sprite_dir: skins}\n");
+  DiskFileReader reader;
+  Analysis a;
+  analyze(a, (tmp.path() / "c.yaml").string(), reader);
+  INFO(a.dump());
+  CHECK(a.count("asset-unreadable") == 2);
+  for (const Diagnostic& d : a.diags.sorted())
+    if (std::string(rule_info(d.rule).id) == "asset-unreadable") CHECK(d.message.find("not valid UTF-8") != std::string::npos);
+}
+
 TEST_CASE("absent keys take the dataclass default, not the YAML value", "[resolve]") {
   const Spec s = resolve_text("physics: {gravity: 0.9}\n");
   CHECK(s.value("physics.gravity") == 0.9);
