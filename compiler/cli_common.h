@@ -34,4 +34,10 @@ std::optional<Spec> resolve_file(const char* command, const std::string& file, c
 /// Prints diagnostics in the chosen format.
 void emit_diagnostics(const DiagEngine& diags, const DiagOptions& opts, CommandIo& io);
 
+/// `j` as the indented text of a JSON file a command writes. Paths from the command line may hold
+/// bytes that are not UTF-8; they become U+FFFD rather than stopping the command.
+inline std::string json_file_text(const Json& j) {
+  return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+
 }  // namespace kage

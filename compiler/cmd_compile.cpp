@@ -148,7 +148,7 @@ int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
       {"builds", builds},
       {"files", file_list},
   };
-  written = written && write_file(dir / "manifest.json", manifest.dump(2) + "\n");
+  written = written && write_file(dir / "manifest.json", json_file_text(manifest));
   if (!written) {
     io.err << "kagec compile: cannot write under '" << dir.string() << "'\n";
     return kExitErrors;

@@ -47,7 +47,7 @@ int cmd_diff(const std::vector<std::string>& args, CommandIo& io) {
   const Certification cert = certify(diff, declared, {});
   if (!output.empty()) {
     std::ofstream f(output, std::ios::binary);
-    f << certificate_json({train_file, train->sha256()}, {eval_file, eval->sha256()}, diff, cert).dump(2) << '\n';
+    f << json_file_text(certificate_json({train_file, train->sha256()}, {eval_file, eval->sha256()}, diff, cert));
     if (!f) {
       io.err << "kagec diff: cannot write '" << output << "'\n";
       return kExitErrors;

@@ -68,13 +68,13 @@ int cmd_suite(const std::vector<std::string>& args, CommandIo& io) {
   size_t isolation_failures = 0;
   if (compile) isolation_failures = add_isolation_evidence(report, json, io.out);
   std::ofstream f(dir / "report.json", std::ios::binary);
-  f << json.dump(2) << '\n';
+  f << json_file_text(json);
   for (const Json& pair : json.at("pairs")) {
     std::string name = pair.at("pair").get<std::string>();
     for (char& c : name)
       if (c == '/' || c == ' ') c = '_';
     std::ofstream cf(dir / "certificates" / (name + ".json"), std::ios::binary);
-    cf << pair.dump(2) << '\n';
+    cf << json_file_text(pair);
   }
   if (!f || ec) {
     io.err << "kagec suite: cannot write the report under '" << dir.string() << "'\n";
