@@ -120,7 +120,13 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
   }
   b.render_threads_ = render_threads(vp);
   b.render_smem_ = render_dynamic_smem_bytes(vp);
-  b.frames_per_block_ = frames_per_block(vp);
+  CUdevice dev;
+  int multiprocessors = 0;
+  if (!check(cuCtxGetDevice(&dev), "cuCtxGetDevice", error) ||
+      !check(cuDeviceGetAttribute(&multiprocessors, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, dev),
+             "cuDeviceGetAttribute(multiprocessors)", error))
+    return std::nullopt;
+  b.frames_per_block_ = frames_per_block(vp, num_envs, multiprocessors);
   if (!check(cuFuncSetAttribute(b.render_, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, b.render_smem_),
              "cuFuncSetAttribute(dynamic shared memory)", error))
     return std::nullopt;

@@ -9,8 +9,8 @@
 // environment and runs 32 environments per warp; the render is parallel per pixel and runs one frame
 // per block at a time. (A fused kernel that stepped inside the rendering block was slower: its serial
 // step and per-frame setup held up the frame's pixels.) Observations are [N][H][W][3] uint8. Frames
-// without neighbourhood filters take the register path (register_path.cuh; frames_per_block() frames
-// per block, one after the other); frames with blur, sharpen or pixelate take the frame-pass path, a
+// without neighbourhood filters take the register path (register_path.cuh; up to 8 frames per block,
+// one after the other); frames with blur, sharpen or pixelate take the frame-pass path, a
 // float32 frame in shared memory (frame_pass.cuh).
 #pragma once
 
@@ -126,23 +126,21 @@ __device__ __forceinline__ void step_body(const DeviceEnvs& e) {
   e.latent[env] = ls;
 }
 
-/// Render: the current states (after reset or step). Block b renders environments
-/// [b * k, b * k + k), + gridDim * k, ..., k = frames_per_block(), one after the other with the whole
-/// block; the layout is read from global memory (only its column table is per pixel).
+/// Render: the current states (after reset or step). Block b renders environments [b * k, b * k + k)
+/// one after the other with the whole block, k = ceil(num_envs / gridDim) (the launch picks the grid
+/// from frames_per_block); the layout is read from global memory (only its column table is per pixel).
 template <class Cfg>
 __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh, float* frame) {
-  const int32_t k = frames_per_block(ParamsOf<Cfg>::visual());
-  for (int32_t first = static_cast<int32_t>(blockIdx.x) * k; first < e.num_envs;
-       first += static_cast<int32_t>(gridDim.x) * k) {
-    const int32_t last = first + k < e.num_envs ? first + k : e.num_envs;
-    for (int32_t env = first; env < last; ++env) {
-      group_copy_words<BlockGroup>(&sh.latent, e.latent + env, static_cast<int32_t>(sizeof(LatentState)));
-      group_copy_words<BlockGroup>(&sh.visual, e.visual + env, e.visual_extent);
-      __syncthreads();
-      render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
-                                    frame_of<Cfg>(e, env));
-      __syncthreads();
-    }
+  const int32_t k = (e.num_envs + static_cast<int32_t>(gridDim.x) - 1) / static_cast<int32_t>(gridDim.x);
+  const int32_t first = static_cast<int32_t>(blockIdx.x) * k;
+  const int32_t last = first + k < e.num_envs ? first + k : e.num_envs;
+  for (int32_t env = first; env < last; ++env) {
+    group_copy_words<BlockGroup>(&sh.latent, e.latent + env, static_cast<int32_t>(sizeof(LatentState)));
+    group_copy_words<BlockGroup>(&sh.visual, e.visual + env, e.visual_extent);
+    __syncthreads();
+    render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
+                                  frame_of<Cfg>(e, env));
+    __syncthreads();
   }
 }
 
@@ -157,7 +155,7 @@ __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n,
 /// Emits the entry points of one config with fixed unmangled names, so that a loader finds them in any
 /// compiled config: kage_reset and kage_step (one thread per environment; any block size),
 /// kage_render (render_threads() threads and render_dynamic_smem_bytes() bytes of dynamic shared memory
-/// per block, frames_per_block() environments per block), kage_sample_actions. Use once per module.
+/// per block, ceil(num_envs / grid) environments per block), kage_sample_actions. Use once per module.
 #define KAGE_INSTANTIATE_KERNELS(CFG)                                                                     \
   extern "C" __global__ void kage_reset(const kage::DeviceEnvs e) { kage::reset_body<CFG>(e); }           \
   extern "C" __global__ void kage_step(const kage::DeviceEnvs e) { kage::step_body<CFG>(e); }   \

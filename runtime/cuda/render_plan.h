@@ -20,7 +20,7 @@ constexpr int32_t kMaxScreenWidth = 1024;
 
 /// Pixels of a 48-byte run of a row (three 16-byte words) in the register path.
 constexpr int32_t kPixelsPerThread = 16;
-/// Threads of a register-path block, and the frames it renders one after the other.
+/// Threads of a register-path block, and the most frames it renders one after the other.
 constexpr int32_t kRegisterPathThreads = 256;
 constexpr int32_t kRegisterPathFramesPerBlock = 8;
 /// Pixels per thread of the frame-pass path (strided), and its largest block: every pixel of the frame
@@ -75,8 +75,15 @@ KAGE_HD bool needs_frame_passes(const VisualParams& p) {
 /// Whether the register path can store whole 16-pixel runs (each row a multiple of 16 pixels).
 KAGE_HD bool register_path_vectorized(const VisualParams& p) { return p.W % kPixelsPerThread == 0; }
 
-/// Frames a rendering block renders, one after the other.
-KAGE_HD int32_t frames_per_block(const VisualParams& p) { return needs_frame_passes(p) ? 1 : kRegisterPathFramesPerBlock; }
+/// Frames a rendering block renders, one after the other, for num_envs environments on
+/// `multiprocessors` SMs: one for the frame-pass path; on the register path up to
+/// kRegisterPathFramesPerBlock, fewer when the batch would then leave SMs short of resident blocks.
+constexpr int32_t kRegisterPathBlocksPerSm = 16;
+KAGE_HD int32_t frames_per_block(const VisualParams& p, int32_t num_envs, int32_t multiprocessors) {
+  if (needs_frame_passes(p)) return 1;
+  const int32_t fill = num_envs / maxi(1, multiprocessors * kRegisterPathBlocksPerSm);
+  return mini(kRegisterPathFramesPerBlock, maxi(1, fill));
+}
 
 /// Threads per rendering block.
 KAGE_HD int32_t render_threads(const VisualParams& p) {
