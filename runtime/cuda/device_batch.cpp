@@ -247,8 +247,6 @@ bool DeviceBatch::download_obs(uint8_t* host, std::string* error) const {
   return check(cuMemcpyDtoH(host, obs(), obs_stride_ * static_cast<size_t>(envs_.num_envs)), "cuMemcpyDtoH(obs)", error);
 }
 
-bool DeviceBatch::render(std::string* error) { return launch_render(error); }
-
 bool DeviceBatch::sample_actions(uint64_t seed, uint32_t t, std::string* error) {
   int32_t* actions = const_cast<int32_t*>(envs_.actions);
   int32_t n = envs_.num_envs;

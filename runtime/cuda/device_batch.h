@@ -46,8 +46,6 @@ class DeviceBatch {
   bool step_device_actions(std::string* error);
   /// One step without rendering (observations are left as they were).
   bool step_no_render(std::string* error);
-  /// Renders the current states into the observations.
-  bool render(std::string* error);
   /// Fills actions() with uniform random actions in [0, 8) for step t, on the device.
   bool sample_actions(uint64_t seed, uint32_t t, std::string* error);
 
