@@ -53,7 +53,8 @@ std::vector<std::string> utf8_characters(const std::string& text) {
   std::vector<std::string> out;
   for (size_t i = 0; i < text.size();) {
     // Malformed bytes (never in a checked file) stay single bytes rather than swallowing neighbours.
-    const size_t len = sequence_at(text, i) > 0 ? sequence_at(text, i) : 1;
+    size_t len = sequence_at(text, i);
+    if (len == 0) len = 1;
     out.push_back(text.substr(i, len));
     i += len;
   }
