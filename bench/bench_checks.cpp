@@ -86,7 +86,7 @@ CheckResult check_against_cpu(const CudaModule& module, const LatentParams& lp, 
     return true;
   };
 
-  if (!poison() || !b->reset(seeds.data(), &res.error)) return res;
+  if (!poison() || !b->reset(seeds.data(), nullptr, &res.error)) return res;
   ref.reset(seeds);
   if (!compare()) return res;
   for (int32_t t = 1; t <= steps; ++t) {
@@ -98,7 +98,7 @@ CheckResult check_against_cpu(const CudaModule& module, const LatentParams& lp, 
     if (check_now && !compare()) return res;
   }
   // The state-only kernel over the same episode from a fresh reset.
-  if (!b->reset(seeds.data(), &res.error)) return res;
+  if (!b->reset(seeds.data(), nullptr, &res.error)) return res;
   ref.reset(seeds);
   for (int32_t t = 1; t <= steps; ++t) {
     if (!b->sample_actions(kActionSeed, static_cast<uint32_t>(t), &res.error) || !b->step_no_render(&res.error))

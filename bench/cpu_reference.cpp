@@ -43,11 +43,8 @@ void CpuReference::step(const std::vector<int32_t>& actions) {
     LatentState& s = latent_[i];
     const StepOutcome o = latent_step(lp_, LayoutView{segments_.data() + static_cast<size_t>(i) * stride_}, s, actions[i]);
     reward_[i] = o.reward;
-    if (o.terminated || o.truncated) {
-      reset_env(i, s.episode + 1);
-    } else {
-      visual_step(vp_, assets_, fold(seed_key(seeds_[i]), s.episode), static_cast<uint32_t>(s.t), s.vx, visual_[i]);
-    }
+    visual_step(vp_, assets_, fold(seed_key(seeds_[i]), s.episode), static_cast<uint32_t>(s.t), s.vx, visual_[i]);
+    if (o.terminated || o.truncated) reset_env(i, s.episode + 1);
   }
 }
 

@@ -130,7 +130,7 @@ double first_step_s(const CudaModule& m, const CompiledDir& c, Clock::time_point
   if (!b) die(c.name + ": " + error);
   std::vector<uint64_t> seeds(1024);
   for (size_t i = 0; i < seeds.size(); ++i) seeds[i] = i;
-  ok_or_die(b->reset(seeds.data(), &error), error);
+  ok_or_die(b->reset(seeds.data(), nullptr, &error), error);
   ok_or_die(b->sample_actions(11, 1, &error), error);
   ok_or_die(b->step_device_actions(&error), error);
   cu_or_die(cuCtxSynchronize(), "cuCtxSynchronize");

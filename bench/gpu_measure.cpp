@@ -85,7 +85,7 @@ Timing time_config(const MeasureTarget& c, int32_t n, bool render, bool state_to
   if (!b) throw MeasureError(error);
   std::vector<uint64_t> seeds(n);
   for (int32_t i = 0; i < n; ++i) seeds[i] = static_cast<uint64_t>(i);
-  ok_or_throw(b->reset(seeds.data(), &error), error);
+  ok_or_throw(b->reset(seeds.data(), nullptr, &error), error);
   uint32_t t = 0;
   auto steps = [&](int32_t count, StepMode mode) {
     for (int32_t s = 0; s < count; ++s) {

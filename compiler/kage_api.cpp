@@ -1,5 +1,6 @@
 // The public API (include/kage/kage.h): a compiled config dir or a YAML file -> a CPU or GPU batch.
-// CPU: the generated kernels_host.so (compiled dir) or the generic CpuEnv (YAML). GPU: runtime/cuda.
+// CPU: HostBatch over the generated kernels_host.so (compiled dir) or the generic path (YAML). GPU:
+// DeviceBatch (runtime/cuda).
 #include "kage/kage.h"
 
 #include <dlfcn.h>
@@ -7,14 +8,15 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "compiler/codegen.h"
-#include "compiler/environment.h"
 #include "compiler/lower.h"
 #include "compiler/resolve.h"
+#include "runtime/host/asset_pack.h"
+#include "runtime/host/host_batch.h"
 #include "runtime/host/specialized_assets.h"
-#include "runtime/host/specialized_batch.h"
 #if defined(KAGE_API_HAVE_CUDA)
 #include "compiler/build.h"
 #include "runtime/cuda/device_batch.h"
@@ -39,23 +41,48 @@ std::optional<std::string> read_file(const fs::path& p) {
   return s.str();
 }
 
-const float* info_column(const BatchInfo& info, InfoField field) {
+constexpr InfoFieldDesc kInfoFields[] = {
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) {InfoField::k##Enum, name, DType::dtype, doc},
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+};
+
+template <class T>
+const void* column_data(const std::vector<T>& v) {
+  return v.data();
+}
+template <class T>
+const void* column_data(T* p) {
+  return p;
+}
+
+/// Column `field` of an info table (host or device pointers).
+template <class Table>
+const void* info_column(const Table& t, InfoField field) {
   switch (field) {
-    case InfoField::kX: return info.x.data();
-    case InfoField::kY: return info.y.data();
-    case InfoField::kVx: return info.vx.data();
-    case InfoField::kVy: return info.vy.data();
-    case InfoField::kPassedDistance: return info.passed_distance.data();
-    case InfoField::kProgress: return info.progress.data();
-    case InfoField::kEpisodeReturn: return info.episode_return.data();
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) \
+  case InfoField::k##Enum:                                     \
+    return column_data(t.member);
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
   }
   return nullptr;
 }
 
-/// The CPU backends' copy_obs: their observations are host memory already.
-void copy_host_obs(const Env& env, uint8_t* dst) {
-  const size_t bytes = static_cast<size_t>(env.num_envs()) * env.height() * env.width() * 3;
-  std::memcpy(dst, env.obs(), bytes);
+/// Host actions as int32, checked to be in 0..7; the reason when they are not.
+std::string host_actions(const Actions& a, int32_t n, std::vector<int32_t>* out) {
+  if (a.dtype != DType::kInt32 && a.dtype != DType::kInt64) return "actions must be int32 or int64";
+  out->resize(static_cast<size_t>(n));
+  for (int32_t i = 0; i < n; ++i) {
+    const int64_t at = static_cast<int64_t>(i) * a.stride;
+    const int64_t v = a.dtype == DType::kInt64 ? static_cast<const int64_t*>(a.data)[at]
+                                               : static_cast<const int32_t*>(a.data)[at];
+    if (v < 0 || v > 7)
+      return "action " + std::to_string(v) + " for environment " + std::to_string(i) +
+             ": an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump)";
+    (*out)[static_cast<size_t>(i)] = static_cast<int32_t>(v);
+  }
+  return {};
 }
 
 /// A lowered config with its Spec hash, from a YAML file or a compiled dir's params.bin.
@@ -85,54 +112,59 @@ std::optional<Loaded> load_yaml(const std::string& path, const Options& options,
   return Loaded{spec->sha256(), *lowered.config};
 }
 
-/// CPU over the generic path (parameters at run time).
-class GenericCpuEnv final : public Env {
+/// The CPU backend: a HostBatch over generated code (a compiled dir's kernels_host.so) or the generic path.
+class HostEnv final : public Env {
  public:
-  GenericCpuEnv(std::unique_ptr<Environment> env, std::string hash) : env_(std::move(env)), hash_(std::move(hash)) {}
-  bool reset(const uint64_t* seeds, std::string*) override { return env_->env().reset(seeds), true; }
-  bool step(const int32_t* actions, std::string*) override { return env_->env().step(actions), true; }
-  Backend backend() const override { return Backend::kCpu; }
-  int32_t num_envs() const override { return env_->env().size(); }
-  int32_t height() const override { return env_->env().height(); }
-  int32_t width() const override { return env_->env().width(); }
-  const std::string& spec_hash() const override { return hash_; }
-  const uint8_t* obs() const override { return env_->env().observations(); }
-  const float* reward() const override { return env_->env().info().reward.data(); }
-  const uint8_t* terminated() const override { return env_->env().info().terminated.data(); }
-  const uint8_t* truncated() const override { return env_->env().info().truncated.data(); }
-  const float* info(InfoField f) const override { return info_column(env_->env().info(), f); }
-  bool copy_obs(uint8_t* dst, std::string*) const override { return copy_host_obs(*this, dst), true; }
-
- private:
-  std::unique_ptr<Environment> env_;
-  std::string hash_;
-};
-
-/// CPU over a compiled dir's generated host library.
-class GeneratedCpuEnv final : public Env {
- public:
-  GeneratedCpuEnv(void* lib, const HostEntryPoints& ep, AssetPack pack, const Options& o, std::string hash)
-      : lib_(lib), pack_(std::move(pack)), batch_(ep, pack_.view(), o.num_envs, o.num_threads), hash_(std::move(hash)) {}
-  ~GeneratedCpuEnv() override { ::dlclose(lib_); }
-  bool reset(const uint64_t* seeds, std::string*) override { return batch_.reset(seeds), true; }
-  bool step(const int32_t* actions, std::string*) override { return batch_.step(actions), true; }
+  HostEnv(void* lib, std::unique_ptr<HostKernels> kernels, AssetPack pack, const Options& o, std::string hash)
+      : lib_(lib), pack_(std::move(pack)), batch_(std::move(kernels), pack_.view(), o.num_envs, o.num_threads),
+        hash_(std::move(hash)) {}
+  ~HostEnv() override {
+    if (lib_) ::dlclose(lib_);
+  }
+  bool reset(const uint64_t* seeds, const uint8_t* mask, std::string*) override {
+    return batch_.reset(seeds, mask), true;
+  }
+  bool step(const Actions& a, std::string* e) override {
+    if (a.memory != Memory::kHost) return fail(e, "kage: device actions given to a CPU environment: pass host memory");
+    const std::string problem = host_actions(a, batch_.size(), &actions_);
+    if (!problem.empty()) return fail(e, "kage: " + problem);
+    return batch_.step(actions_.data()), true;
+  }
   Backend backend() const override { return Backend::kCpu; }
   int32_t num_envs() const override { return batch_.size(); }
   int32_t height() const override { return batch_.visual_params().H; }
   int32_t width() const override { return batch_.visual_params().W; }
   const std::string& spec_hash() const override { return hash_; }
+  void set_stream(void*) override {}
+  void* stream() const override { return nullptr; }
   const uint8_t* obs() const override { return batch_.observations(); }
   const float* reward() const override { return batch_.info().reward.data(); }
   const uint8_t* terminated() const override { return batch_.info().terminated.data(); }
   const uint8_t* truncated() const override { return batch_.info().truncated.data(); }
-  const float* info(InfoField f) const override { return info_column(batch_.info(), f); }
-  bool copy_obs(uint8_t* dst, std::string*) const override { return copy_host_obs(*this, dst), true; }
+  const void* info(InfoField f) const override { return info_column(batch_.info(), f); }
+  const uint8_t* final_mask() const override { return batch_.final_mask(); }
+  const uint8_t* final_obs() const override { return batch_.final_observations(); }
+  const void* final_info(InfoField f) const override { return info_column(batch_.final_info(), f); }
+  bool copy_obs(uint8_t* dst, std::string*) const override {
+    std::memcpy(dst, batch_.observations(), batch_.frame_bytes() * static_cast<size_t>(batch_.size()));
+    return true;
+  }
+  bool synchronize(std::string*) override { return true; }
+  std::string pending_error() override { return {}; }
+  bool save_state(std::vector<uint8_t>* out, std::string*) const override {
+    return *out = batch_.save_state(hash_), true;
+  }
+  bool load_state(const uint8_t* data, size_t size, std::string* e) override {
+    const std::string problem = batch_.load_state(data, size, hash_);
+    return problem.empty() || fail(e, "kage: load_state: " + problem);
+  }
 
  private:
   void* lib_;
   AssetPack pack_;
-  SpecializedCpuBatch batch_;
+  HostBatch batch_;
   std::string hash_;
+  std::vector<int32_t> actions_;
 };
 
 std::unique_ptr<Env> open_compiled_cpu(const fs::path& dir, const Json& manifest, const Options& o,
@@ -147,11 +179,15 @@ std::unique_ptr<Env> open_compiled_cpu(const fs::path& dir, const Json& manifest
   ep.params = reinterpret_cast<decltype(ep.params)>(::dlsym(lib, "kage_host_params"));
   ep.reset_env = reinterpret_cast<decltype(ep.reset_env)>(::dlsym(lib, "kage_host_reset_env"));
   ep.step_env = reinterpret_cast<decltype(ep.step_env)>(::dlsym(lib, "kage_host_step_env"));
+  ep.render_env = reinterpret_cast<decltype(ep.render_env)>(::dlsym(lib, "kage_host_render_env"));
   std::string problem;
-  if (!ep.abi_version || !ep.spec_hash || !ep.params || !ep.reset_env || !ep.step_env)
+  if (!ep.abi_version)
     problem = "missing kage_host_* entry points";
   else if (ep.abi_version() != kHostAbiVersion)
-    problem = "host ABI " + std::to_string(ep.abi_version()) + ", this program speaks " + std::to_string(kHostAbiVersion);
+    problem = "host ABI " + std::to_string(ep.abi_version()) + ", this program speaks " +
+              std::to_string(kHostAbiVersion) + ": compile the config again with this kagec";
+  else if (!ep.spec_hash || !ep.params || !ep.reset_env || !ep.step_env || !ep.render_env)
+    problem = "missing kage_host_* entry points";
   else if (hash != ep.spec_hash())
     problem = "library built for spec " + std::string(ep.spec_hash()) + ", manifest says " + hash;
   const auto blob = read_file(dir / "assets.bin");
@@ -161,7 +197,7 @@ std::unique_ptr<Env> open_compiled_cpu(const fs::path& dir, const Json& manifest
     ::dlclose(lib);
     return fail(error, "kage::open: " + so.string() + ": " + problem), nullptr;
   }
-  return std::make_unique<GeneratedCpuEnv>(lib, ep, std::move(*pack), o, hash);
+  return std::make_unique<HostEnv>(lib, generated_host_kernels(ep), std::move(*pack), o, hash);
 }
 
 #if defined(KAGE_API_HAVE_CUDA)
@@ -170,26 +206,57 @@ class GpuEnv final : public Env {
  public:
   GpuEnv(CudaModule m, DeviceBatch b, AssetPack pack, int32_t H, int32_t W, std::string hash)
       : module_(std::move(m)), pack_(std::move(pack)), batch_(std::move(b)), H_(H), W_(W), hash_(std::move(hash)) {}
-  bool reset(const uint64_t* seeds, std::string* e) override { return batch_.reset(seeds, e); }
-  bool step(const int32_t* actions, std::string* e) override { return batch_.step(actions, e); }
+  bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* e) override {
+    return no_pending_error(e) && batch_.reset(seeds, mask, e);
+  }
+  bool step(const Actions& a, std::string* e) override {
+    if (!no_pending_error(e)) return false;
+    if (a.memory == Memory::kDevice) {
+      if (a.dtype != DType::kInt32 && a.dtype != DType::kInt64) return fail(e, "kage: actions must be int32 or int64");
+      return batch_.step(DeviceActions{reinterpret_cast<CUdeviceptr>(a.data), a.stride, a.dtype == DType::kInt64}, e);
+    }
+    const std::string problem = host_actions(a, batch_.size(), &actions_);
+    if (!problem.empty()) return fail(e, "kage: " + problem);
+    return batch_.step(actions_.data(), e);
+  }
   Backend backend() const override { return Backend::kGpu; }
   int32_t num_envs() const override { return batch_.size(); }
   int32_t height() const override { return H_; }
   int32_t width() const override { return W_; }
   const std::string& spec_hash() const override { return hash_; }
+  void set_stream(void* stream) override { batch_.set_stream(static_cast<CUstream>(stream)); }
+  void* stream() const override { return batch_.stream(); }
   const uint8_t* obs() const override { return reinterpret_cast<const uint8_t*>(batch_.obs()); }
   const float* reward() const override { return reinterpret_cast<const float*>(batch_.reward()); }
   const uint8_t* terminated() const override { return reinterpret_cast<const uint8_t*>(batch_.terminated()); }
   const uint8_t* truncated() const override { return reinterpret_cast<const uint8_t*>(batch_.truncated()); }
-  const float* info(InfoField) const override { return nullptr; }
+  const void* info(InfoField f) const override { return info_column(batch_.info(), f); }
+  const uint8_t* final_mask() const override { return reinterpret_cast<const uint8_t*>(batch_.final_mask()); }
+  const uint8_t* final_obs() const override { return reinterpret_cast<const uint8_t*>(batch_.final_obs()); }
+  const void* final_info(InfoField f) const override { return info_column(batch_.final_info(), f); }
   bool copy_obs(uint8_t* dst, std::string* e) const override { return batch_.download_obs(dst, e); }
+  bool synchronize(std::string* e) override { return batch_.synchronize(e) && no_pending_error(e); }
+  std::string pending_error() override {
+    const std::string problem = batch_.take_action_error();
+    return problem.empty() ? problem : "kage: " + problem;
+  }
+  bool save_state(std::vector<uint8_t>* out, std::string* e) const override { return batch_.save_state(hash_, out, e); }
+  bool load_state(const uint8_t* data, size_t size, std::string* e) override {
+    return batch_.load_state(data, size, hash_, e) || fail(e, "kage: load_state: " + *e);
+  }
 
  private:
+  bool no_pending_error(std::string* e) {
+    const std::string problem = pending_error();
+    return problem.empty() || fail(e, problem);
+  }
+
   CudaModule module_;
   AssetPack pack_;
   DeviceBatch batch_;
   int32_t H_, W_;
   std::string hash_;
+  std::vector<int32_t> actions_;
 };
 
 std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const std::string& fatbin, AssetPack pack,
@@ -207,12 +274,18 @@ std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const 
   if (!m) return nullptr;
   auto b = DeviceBatch::create(*m, l.config.latent, l.config.visual, pack.view(), o.num_envs, error);
   if (!b) return nullptr;
+  b->set_stream(static_cast<CUstream>(o.stream));
   return std::make_unique<GpuEnv>(std::move(*m), std::move(*b), std::move(pack), l.config.visual.H, l.config.visual.W,
                                   l.spec_hash);
 }
 #endif
 
 }  // namespace
+
+const InfoFieldDesc* info_fields(int32_t* count) {
+  *count = static_cast<int32_t>(std::size(kInfoFields));
+  return kInfoFields;
+}
 
 bool gpu_backend_built() {
 #if defined(KAGE_API_HAVE_CUDA)
@@ -252,12 +325,10 @@ std::unique_ptr<Env> open(const std::string& path, const Options& o, std::string
   std::optional<Loaded> l = load_yaml(path, o, error);
   if (!l) return nullptr;
   if (o.backend == Backend::kCpu) {
-    EnvironmentOptions eo;
-    eo.num_envs = o.num_envs;
-    eo.num_threads = o.num_threads;
-    EnvironmentResult r = Environment::from_lowered(l->config, eo);
-    if (!r.ok()) return fail(error, "kage::open: " + r.error), nullptr;
-    return std::make_unique<GenericCpuEnv>(std::move(r.env), l->spec_hash);
+    AssetPackResult assets = load_asset_pack(l->config.assets);
+    if (!assets.ok()) return fail(error, "kage::open: " + assets.error), nullptr;
+    return std::make_unique<HostEnv>(nullptr, generic_host_kernels(l->config.latent, l->config.visual),
+                                     std::move(*assets.pack), o, l->spec_hash);
   }
 #if defined(KAGE_API_HAVE_CUDA)
   AssetPackResult assets = load_asset_pack(l->config.assets);

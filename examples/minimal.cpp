@@ -41,6 +41,6 @@ int main(int argc, char** argv) {
   std::printf("spec %.16s  envs %d  %dx%d  obs fnv1a %016llx\n", env->spec_hash().c_str(), env->num_envs(),
               env->height(), env->width(), static_cast<unsigned long long>(h));
   if (env->backend() == kage::Backend::kCpu)
-    std::printf("total reward %.4f  x[0] %.1f\n", total, env->info(kage::InfoField::kX)[0]);
+    std::printf("total reward %.4f  x[0] %.1f\n", total, static_cast<const float*>(env->info(kage::InfoField::kX))[0]);
   return 0;
 }

@@ -10,12 +10,24 @@
 //   env->step(actions);                 // actions: num_envs int32 (bit 0 left, bit 1 right, bit 2 jump)
 //   const uint8_t* obs = env->obs();    // [num_envs][H][W][3]; device memory on the GPU backend
 //
+// Same-step autoreset (as the original's AutoResetWrapper and Gymnasium 1.x "same-step" mode): a step
+// that ends an episode returns that step's reward and flags, the next episode's first observation and
+// info, and the finished episode's last observation and info in final_obs() / final_info(), flagged in
+// final_mask().
+//
+// GPU ordering: every launch and copy of a batch goes to one CUDA stream (Options::stream, or
+// set_stream), in call order, and no call waits for the device except save_state, load_state, copy_obs
+// and synchronize. A consumer that reads the outputs on that stream, or produces device actions on it,
+// needs no synchronisation; one on another stream orders itself with an event. Outputs are valid until
+// the next reset, step or load_state of the batch has run on its stream.
+//
 // No exception crosses this API: failures return null / false with a message in `error`.
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace kage {
 
@@ -24,17 +36,49 @@ enum class Backend {
   kGpu,  ///< device memory; a compiled dir loads kernels.fatbin (else NVRTC), a YAML is compiled by NVRTC
 };
 
+/// Where an array lives.
+enum class Memory { kHost, kDevice };
+
+/// Element types of the arrays of this API.
+enum class DType { kUInt8, kInt32, kInt64, kFloat32 };
+
 struct Options {
   Backend backend = Backend::kCpu;
   int32_t num_envs = 1;
   int32_t num_threads = 1;  ///< CPU worker threads; results do not depend on it
   /// YAML only: resolve asset paths against this directory (empty: the file that names them).
   std::string asset_root;
+  /// GPU: the CUstream of every launch and copy (null: the legacy default stream).
+  void* stream = nullptr;
 };
 
-/// Per-environment info of the last reset or step (spec 5.8); for an environment whose episode just
-/// ended (and was reset) they describe the finished episode's last step.
-enum class InfoField { kX, kY, kVx, kVy, kPassedDistance, kProgress, kEpisodeReturn };
+/// The per-environment info fields (spec 5.8, plus the episode length): runtime/info_fields.def.
+enum class InfoField {
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) k##Enum,
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+};
+
+/// An info field's original name (`x`, `passed_distance`, `return`, ...), element type and meaning.
+struct InfoFieldDesc {
+  InfoField field;
+  const char* name;
+  DType dtype;
+  const char* doc;
+};
+
+/// Every info field, in runtime/info_fields.def order; `count` receives their number.
+const InfoFieldDesc* info_fields(int32_t* count);
+
+/// Actions for step(): num_envs() integers, element env * stride of `data`. Values outside 0..7 are an
+/// error: host arrays are checked before the step; device arrays are checked by the step kernel and
+/// reported by a later call (pending_error), since checking at once would wait for the device.
+struct Actions {
+  const void* data = nullptr;
+  Memory memory = Memory::kHost;
+  DType dtype = DType::kInt32;  ///< kInt32 or kInt64
+  int64_t stride = 1;           ///< in elements
+};
 
 /// A batch of environments of one configuration.
 class Env {
@@ -42,9 +86,19 @@ class Env {
   virtual ~Env() = default;
 
   /// Starts episode 0 of every environment. `seeds`: num_envs() host values.
-  [[nodiscard]] virtual bool reset(const uint64_t* seeds, std::string* error = nullptr) = 0;
-  /// One step; an environment whose episode ends is reset at once. `actions`: num_envs() host values.
-  [[nodiscard]] virtual bool step(const int32_t* actions, std::string* error = nullptr) = 0;
+  [[nodiscard]] bool reset(const uint64_t* seeds, std::string* error = nullptr) {
+    return reset(seeds, nullptr, error);
+  }
+  /// Starts episode 0, with seeds[env], of the environments with mask[env] != 0 (all of them when `mask`
+  /// is null); the others keep their state and outputs. `seeds` and `mask`: num_envs() host values.
+  /// No environment is final afterwards.
+  [[nodiscard]] virtual bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* error) = 0;
+  /// One step with same-step autoreset. `actions`: num_envs() int32 host values.
+  [[nodiscard]] bool step(const int32_t* actions, std::string* error = nullptr) {
+    return step(Actions{actions, Memory::kHost, DType::kInt32, 1}, error);
+  }
+  /// One step with same-step autoreset; device actions are read in place on the GPU backend.
+  [[nodiscard]] virtual bool step(const Actions& actions, std::string* error) = 0;
 
   virtual Backend backend() const = 0;
   virtual int32_t num_envs() const = 0;
@@ -52,6 +106,9 @@ class Env {
   virtual int32_t width() const = 0;
   /// SHA-256 of the configuration's canonical Spec.
   virtual const std::string& spec_hash() const = 0;
+  /// GPU: the CUstream of later launches and copies (null: the legacy default stream). CPU: ignored.
+  virtual void set_stream(void* stream) = 0;
+  virtual void* stream() const = 0;
 
   /// Outputs of the last reset or step: host pointers on the CPU backend, device pointers (CUdeviceptr
   /// values) on the GPU backend. Valid until the next call.
@@ -59,11 +116,32 @@ class Env {
   virtual const float* reward() const = 0;        ///< [N]
   virtual const uint8_t* terminated() const = 0;  ///< [N] 0/1
   virtual const uint8_t* truncated() const = 0;   ///< [N] 0/1
-  /// CPU: [N] floats of one info field. GPU: null (read the StepInfo array of runtime/cuda instead).
-  virtual const float* info(InfoField field) const = 0;
+  /// [N] values of one info field (element type from info_fields()), of the state after the call: for
+  /// an environment that was reset by the step, the new episode's.
+  virtual const void* info(InfoField field) const = 0;
+  /// [N] 0/1: the last step ended the environment's episode (and reset it). All 0 after reset().
+  virtual const uint8_t* final_mask() const = 0;
+  /// [N][H][W][3]: where final_mask is 1, the finished episode's last observation; other rows are stale.
+  virtual const uint8_t* final_obs() const = 0;
+  /// [N] values of one info field of the finished episode's last step, where final_mask is 1.
+  virtual const void* final_info(InfoField field) const = 0;
+
   /// Copies the observations of the last reset or step (num_envs() * height() * width() * 3 bytes)
   /// into host memory `dst`, on either backend.
   [[nodiscard]] virtual bool copy_obs(uint8_t* dst, std::string* error = nullptr) const = 0;
+  /// Waits until the batch's queued work has finished (GPU), and reports an out-of-range device action
+  /// of an earlier step as an error.
+  [[nodiscard]] virtual bool synchronize(std::string* error = nullptr) = 0;
+  /// An out-of-range device action reported by a step that has finished since the last report (empty
+  /// if none); does not wait.
+  virtual std::string pending_error() = 0;
+
+  /// The whole batch's state and last outputs (about 1.4 KB per environment, not the observations),
+  /// readable by load_state on either backend. Waits for queued work.
+  [[nodiscard]] virtual bool save_state(std::vector<uint8_t>* out, std::string* error = nullptr) const = 0;
+  /// Restores a state saved from the same configuration and environment count, then renders its
+  /// observations: the batch continues exactly as the one that was saved.
+  [[nodiscard]] virtual bool load_state(const uint8_t* data, size_t size, std::string* error = nullptr) = 0;
 };
 
 /// Opens `path`: a directory with manifest.json (from `kagec compile`) or a YAML config. Null on error.

@@ -78,6 +78,15 @@ KAGE_CU_FORWARD(cuMemcpyHtoD, (CUdeviceptr dst, const void* src, size_t bytes), 
 KAGE_CU_FORWARD(cuMemcpyDtoH, (void* dst, CUdeviceptr src, size_t bytes), (dst, src, bytes))
 KAGE_CU_FORWARD(cuMemcpyDtoD, (CUdeviceptr dst, CUdeviceptr src, size_t bytes), (dst, src, bytes))
 KAGE_CU_FORWARD(cuMemsetD8, (CUdeviceptr p, unsigned char v, size_t n), (p, v, n))
+KAGE_CU_FORWARD(cuMemsetD8Async, (CUdeviceptr p, unsigned char v, size_t n, CUstream s), (p, v, n, s))
+KAGE_CU_FORWARD(cuMemcpyHtoDAsync, (CUdeviceptr dst, const void* src, size_t bytes, CUstream s), (dst, src, bytes, s))
+KAGE_CU_FORWARD(cuMemcpyDtoHAsync, (void* dst, CUdeviceptr src, size_t bytes, CUstream s), (dst, src, bytes, s))
+KAGE_CU_FORWARD(cuMemcpy2DAsync, (const CUDA_MEMCPY2D* c, CUstream s), (c, s))
+KAGE_CU_FORWARD(cuMemHostAlloc, (void** p, size_t bytes, unsigned int flags), (p, bytes, flags))
+KAGE_CU_FORWARD(cuMemHostGetDevicePointer, (CUdeviceptr * d, void* p, unsigned int flags), (d, p, flags))
+KAGE_CU_FORWARD(cuMemFreeHost, (void* p), (p))
+KAGE_CU_FORWARD(cuStreamSynchronize, (CUstream s), (s))
+KAGE_CU_FORWARD(cuStreamWaitEvent, (CUstream s, CUevent e, unsigned int flags), (s, e, flags))
 KAGE_CU_FORWARD(cuLaunchKernel,
                 (CUfunction f, unsigned gx, unsigned gy, unsigned gz, unsigned bx, unsigned by, unsigned bz,
                  unsigned smem, CUstream s, void** params, void** extra),

@@ -3,9 +3,11 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstring>
 #include <vector>
 
 #include "runtime/cuda/render_plan.h"
+#include "runtime/host/batch_state.h"
 #include "runtime/latent/latent_state.h"
 #include "runtime/visual/visual_state.h"
 
@@ -25,7 +27,9 @@ bool check(CUresult r, const char* what, std::string* error) {
 
 /// Sub-buffer offsets of the per-env state allocation.
 struct StateLayout {
-  size_t seeds, latent, segments, visual, actions, reward, terminated, truncated, info, total;
+  size_t seeds, latent, segments, visual, actions, reset_mask, reward, terminated, truncated, final_mask, final_latent,
+      final_segments, final_visual, total;
+  size_t info[kInfoFieldCount], final_info[kInfoFieldCount];
 };
 
 StateLayout state_layout(size_t n, size_t segment_stride) {
@@ -41,12 +45,32 @@ StateLayout state_layout(size_t n, size_t segment_stride) {
   l.segments = take(n * segment_stride);
   l.visual = take(n * sizeof(VisualState));
   l.actions = take(n * sizeof(int32_t));
+  l.reset_mask = take(n);
   l.reward = take(n * sizeof(float));
   l.terminated = take(n);
   l.truncated = take(n);
-  l.info = take(n * sizeof(StepInfo));
+  l.final_mask = take(n);
+  l.final_latent = take(n * sizeof(LatentState));
+  l.final_segments = take(n * segment_stride);
+  l.final_visual = take(n * sizeof(VisualState));
+  int i = 0;
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) \
+  l.info[i] = take(n * sizeof(ctype));                         \
+  l.final_info[i++] = take(n * sizeof(ctype));
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
   l.total = at;
   return l;
+}
+
+/// The info columns at `offsets` of the allocation at `base`.
+InfoArrays info_arrays(CUdeviceptr base, const size_t* offsets) {
+  InfoArrays a{};
+  int i = 0;
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) a.member = reinterpret_cast<ctype*>(base + offsets[i++]);
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+  return a;
 }
 
 int32_t frame_count(const AssetView& a) {
@@ -73,8 +97,13 @@ int32_t visual_state_extent(const VisualParams& p, const AssetView& a) {
 }
 
 size_t device_state_bytes_per_env(const LatentParams& lp) {
-  return sizeof(uint64_t) + sizeof(LatentState) + static_cast<size_t>(segment_stride_bytes(layout_segment_count(lp))) +
-         sizeof(VisualState) + sizeof(int32_t) + sizeof(float) + 2 + sizeof(StepInfo);
+  size_t info_bytes = 0;
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) info_bytes += sizeof(ctype);
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+  const size_t stride = static_cast<size_t>(segment_stride_bytes(layout_segment_count(lp)));
+  return sizeof(uint64_t) + 2 * (sizeof(LatentState) + stride + sizeof(VisualState) + info_bytes) + sizeof(int32_t) +
+         sizeof(float) + 4;
 }
 
 std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const LatentParams& lp,
@@ -167,12 +196,20 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
 
   // State and observations.
   const size_t n = static_cast<size_t>(num_envs);
-  const int32_t stride = segment_stride_bytes(layout_segment_count(lp));
+  b.segment_count_ = layout_segment_count(lp);
+  const int32_t stride = segment_stride_bytes(b.segment_count_);
   const StateLayout l = state_layout(n, static_cast<size_t>(stride));
   b.obs_stride_ = static_cast<size_t>(vp.H) * vp.W * 3;
   if (!check(cuMemAlloc(&b.state_, l.total), "cuMemAlloc(state)", error)) return std::nullopt;
   if (!check(cuMemsetD8(b.state_, 0, l.total), "cuMemsetD8(state)", error)) return std::nullopt;
-  if (!check(cuMemAlloc(&b.obs_buf_, n * b.obs_stride_), "cuMemAlloc(observations)", error)) return std::nullopt;
+  if (!check(cuMemAlloc(&b.obs_buf_, 2 * n * b.obs_stride_), "cuMemAlloc(observations)", error)) return std::nullopt;
+  void* mapped = nullptr;
+  CUdeviceptr mapped_device = 0;
+  if (!check(cuMemHostAlloc(&mapped, sizeof(ActionError), CU_MEMHOSTALLOC_DEVICEMAP), "cuMemHostAlloc", error) ||
+      !check(cuMemHostGetDevicePointer(&mapped_device, mapped, 0), "cuMemHostGetDevicePointer", error))
+    return std::nullopt;
+  b.action_error_ = static_cast<ActionError*>(mapped);
+  *b.action_error_ = ActionError{};
   auto ptr = [&](size_t off) { return reinterpret_cast<uint8_t*>(b.state_ + off); };
   DeviceEnvs& e = b.envs_;
   e.num_envs = num_envs;
@@ -182,78 +219,218 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
   e.latent = reinterpret_cast<LatentState*>(ptr(l.latent));
   e.segments = ptr(l.segments);
   e.visual = reinterpret_cast<VisualState*>(ptr(l.visual));
-  e.actions = reinterpret_cast<const int32_t*>(ptr(l.actions));
+  e.actions = ActionSource{ptr(l.actions), 1, 0, 0, reinterpret_cast<ActionError*>(mapped_device)};
+  e.reset_mask = nullptr;
   e.obs = reinterpret_cast<uint8_t*>(b.obs_buf_);
   e.reward = reinterpret_cast<float*>(ptr(l.reward));
   e.terminated = ptr(l.terminated);
   e.truncated = ptr(l.truncated);
-  e.info = reinterpret_cast<StepInfo*>(ptr(l.info));
+  e.info = info_arrays(b.state_, l.info);
+  e.final_mask = ptr(l.final_mask);
+  e.final_latent = reinterpret_cast<LatentState*>(ptr(l.final_latent));
+  e.final_segments = ptr(l.final_segments);
+  e.final_visual = reinterpret_cast<VisualState*>(ptr(l.final_visual));
+  e.final_obs = reinterpret_cast<uint8_t*>(b.obs_buf_ + n * b.obs_stride_);
+  e.final_info = info_arrays(b.state_, l.final_info);
+  b.reset_mask_ = ptr(l.reset_mask);
+  b.seeds_.assign(n, 0);
   return b;
 }
 
 DeviceBatch::DeviceBatch(DeviceBatch&& o) noexcept
     : envs_(o.envs_),
+      stream_(o.stream_),
       obs_stride_(o.obs_stride_),
+      segment_count_(o.segment_count_),
       render_threads_(o.render_threads_),
       render_smem_(o.render_smem_),
       frames_per_block_(o.frames_per_block_),
+      steps_(o.steps_),
       state_(o.state_),
       obs_buf_(o.obs_buf_),
       assets_(o.assets_),
+      reset_mask_(o.reset_mask_),
+      seeds_(std::move(o.seeds_)),
+      action_error_(o.action_error_),
       reset_(o.reset_),
       step_(o.step_),
       render_(o.render_),
       sample_actions_(o.sample_actions_) {
   o.state_ = o.obs_buf_ = o.assets_ = 0;
+  o.action_error_ = nullptr;
 }
 
 DeviceBatch::~DeviceBatch() {
   // Frees fail only once the context is gone at exit, when the memory is released anyway.
   for (CUdeviceptr p : {state_, obs_buf_, assets_})
     if (p) cuMemFree(p);
+  if (action_error_) cuMemFreeHost(action_error_);
 }
 
 bool DeviceBatch::launch_per_env(CUfunction f, std::string* error) {
   void* args[] = {&envs_};
   const unsigned grid = static_cast<unsigned>((envs_.num_envs + kPerEnvThreads - 1) / kPerEnvThreads);
-  return check(cuLaunchKernel(f, grid, 1, 1, kPerEnvThreads, 1, 1, 0, nullptr, args, nullptr), "cuLaunchKernel", error);
+  return check(cuLaunchKernel(f, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream_, args, nullptr), "cuLaunchKernel", error);
 }
 
 bool DeviceBatch::launch_render(std::string* error) {
   void* args[] = {&envs_};
   const unsigned grid = static_cast<unsigned>((envs_.num_envs + frames_per_block_ - 1) / frames_per_block_);
   return check(cuLaunchKernel(render_, grid, 1, 1, static_cast<unsigned>(render_threads_),
-                              1, 1, static_cast<unsigned>(render_smem_), nullptr, args, nullptr),
+                              1, 1, static_cast<unsigned>(render_smem_), stream_, args, nullptr),
                "cuLaunchKernel", error);
 }
 
-bool DeviceBatch::reset(const uint64_t* seeds, std::string* error) {
+bool DeviceBatch::reset(const uint64_t* seeds, const uint8_t* mask, std::string* error) {
+  const size_t n = static_cast<size_t>(envs_.num_envs);
+  // Environments outside the mask keep their seeds: the device array is rewritten whole.
+  for (size_t i = 0; i < n; ++i)
+    if (!mask || mask[i]) seeds_[i] = seeds[i];
   const CUdeviceptr d = reinterpret_cast<CUdeviceptr>(envs_.seeds);
-  return check(cuMemcpyHtoD(d, seeds, sizeof(uint64_t) * envs_.num_envs), "cuMemcpyHtoD(seeds)", error) &&
-         launch_per_env(reset_, error) && launch_render(error);
+  if (!check(cuMemcpyHtoDAsync(d, seeds_.data(), sizeof(uint64_t) * n, stream_), "cuMemcpyHtoDAsync(seeds)", error))
+    return false;
+  if (mask && !check(cuMemcpyHtoDAsync(reinterpret_cast<CUdeviceptr>(reset_mask_), mask, n, stream_),
+                     "cuMemcpyHtoDAsync(reset mask)", error))
+    return false;
+  envs_.reset_mask = mask ? reset_mask_ : nullptr;
+  const bool ok = launch_per_env(reset_, error);
+  envs_.reset_mask = nullptr;
+  return ok && launch_render(error);
+}
+
+bool DeviceBatch::launch_step(const ActionSource& source, bool render, std::string* error) {
+  const ActionSource own = envs_.actions;
+  envs_.actions = source;
+  envs_.actions.step = ++steps_;
+  envs_.actions.error = own.error;
+  const bool ok = launch_per_env(step_, error);
+  envs_.actions = own;
+  return ok && (!render || launch_render(error));
 }
 
 bool DeviceBatch::step(const int32_t* actions, std::string* error) {
-  return check(cuMemcpyHtoD(this->actions(), actions, sizeof(int32_t) * envs_.num_envs), "cuMemcpyHtoD(actions)",
-               error) &&
+  return check(cuMemcpyHtoDAsync(this->actions(), actions, sizeof(int32_t) * envs_.num_envs, stream_),
+               "cuMemcpyHtoDAsync(actions)", error) &&
          step_device_actions(error);
 }
 
-bool DeviceBatch::step_device_actions(std::string* error) { return step_no_render(error) && launch_render(error); }
+bool DeviceBatch::step(const DeviceActions& a, std::string* error) {
+  return launch_step(ActionSource{reinterpret_cast<const void*>(a.data), a.stride, a.is_int64 ? 1 : 0, 0, nullptr},
+                     true, error);
+}
 
-bool DeviceBatch::step_no_render(std::string* error) { return launch_per_env(step_, error); }
+bool DeviceBatch::step_device_actions(std::string* error) { return launch_step(envs_.actions, true, error); }
+
+bool DeviceBatch::step_no_render(std::string* error) { return launch_step(envs_.actions, false, error); }
+
+std::string DeviceBatch::take_action_error() {
+  volatile ActionError* e = action_error_;
+  if (e->state != 2u) return {};
+  const std::string text = "the actions of step " + std::to_string(e->step) + " held " + std::to_string(e->value) +
+                           " for environment " + std::to_string(e->env) +
+                           ": an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump); that step ran "
+                           "with the value masked to its low 3 bits";
+  e->state = 0u;
+  return text;
+}
+
+bool DeviceBatch::synchronize(std::string* error) const {
+  return check(cuStreamSynchronize(stream_), "cuStreamSynchronize", error);
+}
 
 bool DeviceBatch::download_obs(uint8_t* host, std::string* error) const {
-  return check(cuMemcpyDtoH(host, obs(), obs_stride_ * static_cast<size_t>(envs_.num_envs)), "cuMemcpyDtoH(obs)", error);
+  return check(cuMemcpyDtoHAsync(host, obs(), obs_stride_ * static_cast<size_t>(envs_.num_envs), stream_),
+               "cuMemcpyDtoHAsync(obs)", error) &&
+         synchronize(error);
 }
 
 bool DeviceBatch::sample_actions(uint64_t seed, uint32_t t, std::string* error) {
-  int32_t* actions = const_cast<int32_t*>(envs_.actions);
+  CUdeviceptr actions = this->actions();
   int32_t n = envs_.num_envs;
   void* args[] = {&actions, &n, &seed, &t};
   const unsigned grid = static_cast<unsigned>((n + kPerEnvThreads - 1) / kPerEnvThreads);
-  return check(cuLaunchKernel(sample_actions_, grid, 1, 1, kPerEnvThreads, 1, 1, 0, nullptr, args, nullptr),
+  return check(cuLaunchKernel(sample_actions_, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream_, args, nullptr),
                "cuLaunchKernel(kage_sample_actions)", error);
+}
+
+namespace {
+
+/// One section of a saved state: `bytes_per_env` bytes per environment at `device` (rows `pitch`
+/// bytes apart) and at offset `blob` of the saved state (rows packed).
+struct StateSection {
+  CUdeviceptr device;
+  size_t blob;
+  size_t bytes_per_env;
+  size_t pitch;
+};
+
+std::vector<StateSection> state_sections(const DeviceEnvs& e, const BatchStateLayout& l, size_t segment_bytes) {
+  auto at = [](const void* p) { return reinterpret_cast<CUdeviceptr>(p); };
+  std::vector<StateSection> s = {
+      {at(e.seeds), l.seeds, sizeof(uint64_t), sizeof(uint64_t)},
+      {at(e.latent), l.latent, sizeof(LatentState), sizeof(LatentState)},
+      {at(e.segments), l.segments, segment_bytes, static_cast<size_t>(e.segment_stride)},
+      {at(e.visual), l.visual, sizeof(VisualState), sizeof(VisualState)},
+      {at(e.reward), l.reward, sizeof(float), sizeof(float)},
+      {at(e.terminated), l.terminated, 1, 1},
+      {at(e.truncated), l.truncated, 1, 1},
+  };
+  int i = 0;
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) \
+  s.push_back({at(e.info.member), l.info[i++], sizeof(ctype), sizeof(ctype)});
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+  return s;
+}
+
+}  // namespace
+
+bool DeviceBatch::save_state(const std::string& spec_hash, std::vector<uint8_t>* out, std::string* error) const {
+  const size_t n = static_cast<size_t>(envs_.num_envs);
+  const BatchStateLayout l(n, static_cast<size_t>(segment_count_));
+  out->assign(l.total, 0);
+  write_batch_state_header(out->data(), envs_.num_envs, segment_count_, spec_hash);
+  for (const StateSection& s : state_sections(envs_, l, static_cast<size_t>(segment_count_))) {
+    CUDA_MEMCPY2D c{};
+    c.srcMemoryType = CU_MEMORYTYPE_DEVICE;
+    c.srcDevice = s.device;
+    c.srcPitch = s.pitch;
+    c.dstMemoryType = CU_MEMORYTYPE_HOST;
+    c.dstHost = out->data() + s.blob;
+    c.dstPitch = s.bytes_per_env;
+    c.WidthInBytes = s.bytes_per_env;
+    c.Height = n;
+    if (!check(cuMemcpy2DAsync(&c, stream_), "cuMemcpy2DAsync(save state)", error)) return false;
+  }
+  return synchronize(error);
+}
+
+bool DeviceBatch::load_state(const uint8_t* data, size_t size, const std::string& spec_hash, std::string* error) {
+  const std::string problem = check_batch_state(data, size, envs_.num_envs, segment_count_, spec_hash);
+  if (!problem.empty()) {
+    *error = problem;
+    return false;
+  }
+  const size_t n = static_cast<size_t>(envs_.num_envs);
+  const BatchStateLayout l(n, static_cast<size_t>(segment_count_));
+  for (const StateSection& s : state_sections(envs_, l, static_cast<size_t>(segment_count_))) {
+    CUDA_MEMCPY2D c{};
+    c.srcMemoryType = CU_MEMORYTYPE_HOST;
+    c.srcHost = data + s.blob;
+    c.srcPitch = s.bytes_per_env;
+    c.dstMemoryType = CU_MEMORYTYPE_DEVICE;
+    c.dstDevice = s.device;
+    c.dstPitch = s.pitch;
+    c.WidthInBytes = s.bytes_per_env;
+    c.Height = n;
+    if (!check(cuMemcpy2DAsync(&c, stream_), "cuMemcpy2DAsync(load state)", error)) return false;
+  }
+  std::memcpy(seeds_.data(), data + l.seeds, n * sizeof(uint64_t));
+  // Frames are a pure function of the state: render them again instead of saving them. The copies
+  // read pageable host memory, so they are complete when this returns.
+  return check(cuMemsetD8Async(reinterpret_cast<CUdeviceptr>(envs_.final_mask), 0, n, stream_),
+               "cuMemsetD8Async(final mask)", error) &&
+         launch_render(error) && synchronize(error);
 }
 
 }  // namespace kage

@@ -1,5 +1,9 @@
 // GPU batch runtime: N environments of one compiled config in device memory, stepped and rendered by
 // the kernels of a loaded module (kernels.cuh entry points). Observations stay on the device.
+//
+// Every launch and copy goes to one CUDA stream (set_stream; the legacy default stream unless set), in
+// call order, so a consumer on that stream needs no synchronisation. Nothing here waits for the device
+// except the calls documented as synchronising (downloads, save_state, load_state).
 #pragma once
 
 #include <cuda.h>
@@ -7,6 +11,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "runtime/cuda/device_envs.h"
 #include "runtime/cuda/module_loader.h"
@@ -16,13 +21,20 @@
 
 namespace kage {
 
-/// Bytes of one environment's device state: latent state, layout, visual state, seed, action, reward,
-/// flags and info (the observation not included).
+/// Bytes of one environment's device state besides the observations: latent state, layout, visual
+/// state, seed, action, reward, flags, info, and the final state and info kept by autoreset.
 size_t device_state_bytes_per_env(const LatentParams& lp);
 
 /// Leading bytes of VisualState that a step or a render of this config can read or write: the entity
 /// arrays of disabled entity kinds are never touched, so the rendering blocks copy only this prefix.
 int32_t visual_state_extent(const VisualParams& vp, const AssetView& assets);
+
+/// Actions in device memory: element env * stride of an int32 or int64 array.
+struct DeviceActions {
+  CUdeviceptr data = 0;
+  int64_t stride = 1;
+  bool is_int64 = false;
+};
 
 class DeviceBatch {
  public:
@@ -38,45 +50,75 @@ class DeviceBatch {
   DeviceBatch& operator=(const DeviceBatch&) = delete;
   ~DeviceBatch();
 
-  /// Starts episode 0 of every environment (`seeds`: size() host values) and renders the observations.
-  bool reset(const uint64_t* seeds, std::string* error);
+  /// The stream of every later launch and copy (0: the legacy default stream).
+  void set_stream(CUstream stream) { stream_ = stream; }
+  CUstream stream() const { return stream_; }
+
+  /// Starts episode 0 with the new seeds of the environments with mask[env] != 0 (every one when `mask`
+  /// is null) and renders the observations; `seeds` and `mask` are size() host values. No environment
+  /// is final afterwards.
+  bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* error);
   /// Uploads size() host actions and runs one step (with autoreset), then renders the observations.
   bool step(const int32_t* actions, std::string* error);
-  /// step() with the actions already in device memory (actions()).
+  /// One step reading the actions from device memory (no copy), then the render.
+  bool step(const DeviceActions& actions, std::string* error);
+  /// step() with the actions already in the batch's own buffer (actions()).
   bool step_device_actions(std::string* error);
   /// One step without rendering (observations are left as they were).
   bool step_no_render(std::string* error);
   /// Fills actions() with uniform random actions in [0, 8) for step t, on the device.
   bool sample_actions(uint64_t seed, uint32_t t, std::string* error);
+  /// The first out-of-range device action a finished step reported ("" if none), then forgets it. Reads
+  /// host-mapped memory: no synchronisation, so a report arrives once its step has run.
+  std::string take_action_error();
 
   int32_t size() const { return envs_.num_envs; }
-  /// Device pointers ([N][H][W][3] uint8, [N] float, [N] uint8, [N] uint8, [N] StepInfo, [N] int32).
+  /// Device pointers: [N][H][W][3] uint8 observations, [N] float reward, [N] uint8 flags.
   CUdeviceptr obs() const { return reinterpret_cast<CUdeviceptr>(envs_.obs); }
-  /// Copies every observation into host memory (size() * obs_bytes_per_env() bytes).
-  bool download_obs(uint8_t* host, std::string* error) const;
   CUdeviceptr reward() const { return reinterpret_cast<CUdeviceptr>(envs_.reward); }
   CUdeviceptr terminated() const { return reinterpret_cast<CUdeviceptr>(envs_.terminated); }
   CUdeviceptr truncated() const { return reinterpret_cast<CUdeviceptr>(envs_.truncated); }
-  CUdeviceptr info() const { return reinterpret_cast<CUdeviceptr>(envs_.info); }
-  CUdeviceptr actions() const { return reinterpret_cast<CUdeviceptr>(envs_.actions); }
+  CUdeviceptr actions() const { return reinterpret_cast<CUdeviceptr>(envs_.actions.data); }
+  /// [N] device columns of the info; final_*: the finished episodes of the last step (final_mask 1).
+  const InfoArrays& info() const { return envs_.info; }
+  const InfoArrays& final_info() const { return envs_.final_info; }
+  CUdeviceptr final_mask() const { return reinterpret_cast<CUdeviceptr>(envs_.final_mask); }
+  CUdeviceptr final_obs() const { return reinterpret_cast<CUdeviceptr>(envs_.final_obs); }
+  /// Copies every observation into host memory (size() * obs_bytes_per_env() bytes); synchronises.
+  bool download_obs(uint8_t* host, std::string* error) const;
   /// The device view the kernels get (latent, layout and visual state pointers included).
   const DeviceEnvs& envs() const { return envs_; }
   size_t obs_bytes_per_env() const { return obs_stride_; }
+  int32_t segment_bytes() const { return segment_count_; }
+
+  /// The saved state (runtime/host/batch_state.h) under `spec_hash`; synchronises.
+  bool save_state(const std::string& spec_hash, std::vector<uint8_t>* out, std::string* error) const;
+  /// Restores a saved state and renders its observations.
+  bool load_state(const uint8_t* data, size_t size, const std::string& spec_hash, std::string* error);
+  /// Waits until every launch and copy of this batch has finished.
+  bool synchronize(std::string* error) const;
 
  private:
   DeviceBatch() = default;
   bool launch_per_env(CUfunction f, std::string* error);
   /// Launches the render kernel: frames_per_block_ environments per block.
   bool launch_render(std::string* error);
+  bool launch_step(const ActionSource& source, bool render, std::string* error);
 
   DeviceEnvs envs_{};
+  CUstream stream_ = nullptr;
   size_t obs_stride_ = 0;
+  int32_t segment_count_ = 0;
   int32_t render_threads_ = 0;
   int32_t render_smem_ = 0;
   int32_t frames_per_block_ = 1;
-  CUdeviceptr state_ = 0;   ///< one allocation for every per-env array but the observations
-  CUdeviceptr obs_buf_ = 0;
+  uint64_t steps_ = 0;       ///< steps launched, reported with an out-of-range action
+  CUdeviceptr state_ = 0;    ///< one allocation for every per-env array but the observations
+  CUdeviceptr obs_buf_ = 0;  ///< observations, then final observations
   CUdeviceptr assets_ = 0;
+  uint8_t* reset_mask_ = nullptr;        ///< device buffer for a reset's mask
+  std::vector<uint64_t> seeds_;          ///< host copy of the device seeds
+  ActionError* action_error_ = nullptr;  ///< host-mapped
   CUfunction reset_ = nullptr;
   CUfunction step_ = nullptr;
   CUfunction render_ = nullptr;

@@ -2,6 +2,7 @@
 // as the one argument of every kernel (kernels.cuh). Host and device (nvcc, NVRTC), no std headers.
 #pragma once
 
+#include "runtime/episode_info.h"
 #include "runtime/kage_hd.h"
 #include "runtime/latent/latent_state.h"
 #include "runtime/visual/asset_view.h"
@@ -9,25 +10,23 @@
 
 namespace kage {
 
-/// Per-environment results of the last reset or step besides reward and the two flags (the info of
-/// spec 5.8). After an automatic reset they describe the finished episode's last step.
-struct StepInfo {
-  float x;
-  float y;
-  float vx;
-  float vy;
-  float passed_distance;
-  float progress;
-  float episode_return;
-  int32_t jump_count;
-  int32_t timestep;
-  uint8_t success;
-  uint8_t success_once;
-  uint8_t pad[2];
+/// The first out-of-range action a step kernel saw (in host-mapped memory, so the host reads it without
+/// a copy). `state` is 0 until then, 1 while the reporting thread writes, 2 once the fields are complete.
+struct ActionError {
+  uint32_t state;
+  int32_t env;
+  int64_t value;
+  uint64_t step;   ///< ActionSource::step of the launch
 };
 
-static_assert(__is_trivially_copyable(StepInfo), "StepInfo must be POD");
-static_assert(sizeof(StepInfo) == 40, "StepInfo layout changed");
+/// Where a step kernel reads its actions: element `env * stride` of an int32 or int64 device array.
+struct ActionSource {
+  const void* data;
+  int64_t stride;        ///< in elements
+  int32_t is_int64;      ///< 0: int32 elements, 1: int64
+  uint64_t step;         ///< the host's step counter, reported with an out-of-range value
+  ActionError* error;    ///< host-mapped; values outside 0..7 are reported here (then masked, spec 3.2)
+};
 
 /// Every buffer of a device batch (structure of arrays over environments; the latent and visual
 /// states are arrays of structs, copied whole into shared memory by the block that renders them).
@@ -40,12 +39,21 @@ struct DeviceEnvs {
   LatentState* latent;         ///< [N]
   uint8_t* segments;           ///< [N][segment_stride]
   VisualState* visual;         ///< [N]
-  const int32_t* actions;      ///< [N], read by the step kernels
+  ActionSource actions;        ///< read by the step kernel
+  const uint8_t* reset_mask;   ///< [N] for the reset kernel: reset where 1 (null: every environment)
   uint8_t* obs;                ///< [N][H][W][3]
   float* reward;               ///< [N]
   uint8_t* terminated;         ///< [N]
   uint8_t* truncated;          ///< [N]
-  StepInfo* info;              ///< [N]
+  InfoArrays info;             ///< [N] each: the state after the call (a new episode's after autoreset)
+  // Same-step autoreset: a step that ends an episode keeps its last state here and the render kernel
+  // draws it into final_obs.
+  uint8_t* final_mask;         ///< [N] 0/1: the last step ended the episode
+  LatentState* final_latent;   ///< [N]
+  uint8_t* final_segments;     ///< [N][segment_stride]
+  VisualState* final_visual;   ///< [N]
+  uint8_t* final_obs;          ///< [N][H][W][3]
+  InfoArrays final_info;       ///< [N] each
   AssetView assets;            ///< pointers rebased to device memory
 };
 

@@ -74,34 +74,47 @@ __device__ __forceinline__ void record_outcome(const DeviceEnvs& e, int32_t env,
   e.reward[env] = o.reward;
   e.terminated[env] = o.terminated;
   e.truncated[env] = o.truncated;
-  StepInfo info;
-  info.x = s.x;
-  info.y = s.y;
-  info.vx = s.vx;
-  info.vy = s.vy;
-  info.passed_distance = o.passed_distance;
-  info.progress = o.progress;
-  info.episode_return = s.episode_return;
-  info.jump_count = s.jump_count;
-  info.timestep = s.t;
-  info.success = o.success;
-  info.success_once = s.success_once;
-  info.pad[0] = info.pad[1] = 0;
-  e.info[env] = info;
+  record_info(e.info, env, s, o);
 }
 
-/// One step of one environment with automatic reset (the order of CpuBatch::step): the latent step,
-/// its outcome, then either the next episode's reset or the visual step (spec 5.7, 5.9).
-__device__ __forceinline__ void device_step_env(const LatentParams& lp, const VisualParams& vp, const DeviceEnvs& e,
-                                         int32_t env, uint8_t* segments, LatentState& ls, VisualState& vs) {
-  const StepOutcome o = latent_step(lp, LayoutView{segments}, ls, e.actions[env]);
-  record_outcome(e, env, ls, o);
-  if (o.terminated || o.truncated) {
-    const uint32_t next = ls.episode + 1;
-    device_reset_env(lp, vp, e.assets, device_episode_key(e, env, next), next, segments, ls, vs);
-  } else {
-    visual_step(vp, e.assets, device_episode_key(e, env, ls.episode), static_cast<uint32_t>(ls.t), ls.vx, vs);
+/// Copies `bytes` (a multiple of 4) from `src` to `dst` a word at a time.
+__device__ __forceinline__ void copy_words(void* dst, const void* src, int32_t bytes) {
+  for (int32_t i = 0; i < bytes / 4; ++i) static_cast<uint32_t*>(dst)[i] = static_cast<const uint32_t*>(src)[i];
+}
+
+/// The action of environment `env`. A value outside 0..7 is reported to the host (the first one per
+/// launch wins) and then masked like any other (spec 3.2).
+__device__ __forceinline__ int32_t load_action(const ActionSource& a, int32_t env) {
+  const int64_t i = static_cast<int64_t>(env) * a.stride;
+  const int64_t v = a.is_int64 ? static_cast<const int64_t*>(a.data)[i] : static_cast<const int32_t*>(a.data)[i];
+  if ((v < 0 || v > 7) && a.error && atomicCAS(&a.error->state, 0u, 1u) == 0u) {
+    a.error->env = env;
+    a.error->value = v;
+    a.error->step = a.step;
+    __threadfence_system();
+    atomicExch(&a.error->state, 2u);
   }
+  return static_cast<int32_t>(v);
+}
+
+/// One step of one environment with same-step automatic reset (the order of HostBatch::step): the
+/// latent step and its outcome; then the visual step of the new t; if the episode ended, its last
+/// state goes to the final_* buffers (the render kernel draws it) and the next episode starts.
+__device__ __forceinline__ void device_step_env(const LatentParams& lp, const VisualParams& vp, const DeviceEnvs& e,
+                                                int32_t env, uint8_t* segments, LatentState& ls, VisualState& vs) {
+  const StepOutcome o = latent_step(lp, LayoutView{segments}, ls, load_action(e.actions, env));
+  record_outcome(e, env, ls, o);
+  visual_step(vp, e.assets, device_episode_key(e, env, ls.episode), static_cast<uint32_t>(ls.t), ls.vx, vs);
+  const bool done = o.terminated || o.truncated;
+  e.final_mask[env] = done ? 1 : 0;
+  if (!done) return;
+  e.final_latent[env] = ls;
+  copy_words(e.final_segments + static_cast<int64_t>(env) * e.segment_stride, segments, e.segment_stride);
+  copy_words(e.final_visual + env, &vs, e.visual_extent);
+  copy_info_row(e.final_info, e.info, env);
+  const uint32_t next = ls.episode + 1;
+  device_reset_env(lp, vp, e.assets, device_episode_key(e, env, next), next, segments, ls, vs);
+  record_info(e.info, env, ls, StepOutcome{});
 }
 
 }  // namespace kage

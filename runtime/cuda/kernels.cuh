@@ -75,11 +75,11 @@ __device__ __forceinline__ void render_frame(const DeviceEnvs& e, int32_t env, S
   render_register_path<Cfg, Group>(e.assets, sh, solid, out);
 }
 
-/// The frame of environment env.
+/// The frame of environment env in `frames` (obs or final_obs).
 template <class Cfg>
-__device__ __forceinline__ uint8_t* frame_of(const DeviceEnvs& e, int32_t env) {
+__device__ __forceinline__ uint8_t* frame_of(uint8_t* frames, int32_t env) {
   const VisualParams& vp = ParamsOf<Cfg>::visual();
-  return e.obs + static_cast<int64_t>(env) * vp.H * vp.W * 3;
+  return frames + static_cast<int64_t>(env) * vp.H * vp.W * 3;
 }
 
 /// Launch bounds of the render kernel: at most a frame-pass block; a config that certainly takes the
@@ -102,11 +102,14 @@ struct RenderBounds<DynamicCfg> {
 
 // ---- kernel bodies (the extern "C" entry points are emitted by KAGE_INSTANTIATE_KERNELS) ----
 
-/// Reset: one thread per environment starts episode 0 (no rendering; see render_body).
+/// Reset: one thread per environment starts episode 0 where reset_mask says so (every environment when
+/// it is null); no environment is final afterwards. No rendering (see render_body).
 template <class Cfg>
 __device__ __forceinline__ void reset_body(const DeviceEnvs& e) {
   const int32_t env = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (env >= e.num_envs) return;
+  e.final_mask[env] = 0;
+  if (e.reset_mask && !e.reset_mask[env]) return;
   LatentState ls;
   device_reset_env(ParamsOf<Cfg>::latent(), ParamsOf<Cfg>::visual(), e.assets, device_episode_key(e, env, 0), 0,
             e.segments + static_cast<int64_t>(env) * e.segment_stride, ls, e.visual[env]);
@@ -126,7 +129,8 @@ __device__ __forceinline__ void step_body(const DeviceEnvs& e) {
   e.latent[env] = ls;
 }
 
-/// Render: the current states (after reset or step). Block b renders environments [b * k, b * k + k)
+/// Render: the current states (after reset or step), and the final states of environments whose episode
+/// the step ended. Block b renders environments [b * k, b * k + k)
 /// one after the other with the whole block, k = ceil(num_envs / gridDim) (the launch picks the grid
 /// from frames_per_block); the layout is read from global memory (only its column table is per pixel).
 template <class Cfg>
@@ -139,8 +143,17 @@ __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh
     group_copy_words<BlockGroup>(&sh.visual, e.visual + env, e.visual_extent);
     __syncthreads();
     render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
-                                  frame_of<Cfg>(e, env));
+                                  frame_of<Cfg>(e.obs, env));
     __syncthreads();
+    if (e.final_mask[env]) {
+      // The finished episode's last frame, from the state and layout the step kernel kept.
+      group_copy_words<BlockGroup>(&sh.latent, e.final_latent + env, static_cast<int32_t>(sizeof(LatentState)));
+      group_copy_words<BlockGroup>(&sh.visual, e.final_visual + env, e.visual_extent);
+      __syncthreads();
+      render_frame<Cfg, BlockGroup>(e, env, sh, e.final_segments + static_cast<int64_t>(env) * e.segment_stride,
+                                    frame, frame_of<Cfg>(e.final_obs, env));
+      __syncthreads();
+    }
   }
 }
 

@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "runtime/episode_info.h"
 #include "runtime/latent/latent_params.h"
 #include "runtime/latent/latent_state.h"
 #include "runtime/latent/layout.h"
@@ -34,29 +35,41 @@ struct CpuBatchOptions {
   bool autoreset = true;    ///< reset a finished episode at once with the next episode key
 };
 
-/// Per-environment results of the last reset or step (structure of arrays, N entries each). After an
-/// automatic reset they describe the finished episode's last step (the info of spec 5.8).
-struct BatchInfo {
-  std::vector<float> reward;
-  std::vector<uint8_t> terminated;
-  std::vector<uint8_t> truncated;
-  std::vector<float> x;
-  std::vector<float> y;
-  std::vector<float> vx;
-  std::vector<float> vy;
-  std::vector<float> passed_distance;
-  std::vector<float> progress;
-  std::vector<uint8_t> success;
-  std::vector<uint8_t> success_once;
-  std::vector<float> episode_return;  ///< info "return"
-  std::vector<int32_t> jump_count;
-  std::vector<int32_t> timestep;      ///< info "timestep" = t
+/// The info columns of runtime/info_fields.def for N environments (structure of arrays).
+struct InfoTable {
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) std::vector<ctype> member;
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
 
   /// Sizes every column for n environments, zeroed.
   void resize(size_t n) {
-    for (auto* v : {&reward, &x, &y, &vx, &vy, &passed_distance, &progress, &episode_return}) v->assign(n, 0.0f);
-    for (auto* v : {&terminated, &truncated, &success, &success_once}) v->assign(n, 0);
-    for (auto* v : {&jump_count, &timestep}) v->assign(n, 0);
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) member.assign(n, ctype{});
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+  }
+
+  /// The columns as pointers (valid until the next resize).
+  InfoArrays columns() {
+    InfoArrays a;
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) a.member = member.data();
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+    return a;
+  }
+};
+
+/// Per-environment results of the last reset or step: reward, flags and the info columns.
+struct BatchInfo : InfoTable {
+  std::vector<float> reward;
+  std::vector<uint8_t> terminated;
+  std::vector<uint8_t> truncated;
+
+  /// Sizes every column for n environments, zeroed.
+  void resize(size_t n) {
+    InfoTable::resize(n);
+    reward.assign(n, 0.0f);
+    terminated.assign(n, 0);
+    truncated.assign(n, 0);
   }
 
   /// Writes environment env's row from its state after a step (or a reset, with a zero outcome).
@@ -65,17 +78,7 @@ struct BatchInfo {
     reward[env] = o.reward;
     terminated[env] = o.terminated;
     truncated[env] = o.truncated;
-    x[env] = s.x;
-    y[env] = s.y;
-    vx[env] = s.vx;
-    vy[env] = s.vy;
-    passed_distance[env] = o.passed_distance;
-    progress[env] = o.progress;
-    success[env] = o.success;
-    success_once[env] = s.success_once;
-    episode_return[env] = s.episode_return;
-    jump_count[env] = s.jump_count;
-    timestep[env] = s.t;
+    record_info(columns(), env, s, o);
   }
 };
 
@@ -99,6 +102,8 @@ class CpuBatch {
 
   int32_t size() const { return num_envs_; }
   const LatentParams& params() const { return params_; }
+  /// Reward, flags and info of the last reset or step; after an automatic reset, of the finished
+  /// episode's last step.
   const BatchInfo& info() const { return info_; }
   /// Observations [N][H][W][3] of the last reset or step (the new episode's after an automatic reset).
   const uint8_t* observations() const { return obs_.data(); }

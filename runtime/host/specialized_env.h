@@ -50,7 +50,7 @@ inline StepOutcome env_step(const LatentParams& lp, const VisualParams& vp, cons
 }
 
 /// Version of the kage_host_* entry points below; a loader refuses a library with another one.
-inline constexpr int32_t kHostAbiVersion = 1;
+inline constexpr int32_t kHostAbiVersion = 2;
 
 /// The entry points of a generated host library, as function pointers (filled by dlsym, or taken
 /// from a generated file compiled into the program).
@@ -61,6 +61,7 @@ struct HostEntryPoints {
   void (*reset_env)(const AssetView* assets, Key episode_key, uint32_t episode, const EnvSlot* e);
   void (*step_env)(const AssetView* assets, Key episode_key, int32_t action, int32_t render, const EnvSlot* e,
                    StepOutcome* out);
+  void (*render_env)(const AssetView* assets, Key episode_key, const EnvSlot* e);
 };
 
 /// The same entry points for a config type: Cfg::latent() and Cfg::visual() are constant expressions.
@@ -81,7 +82,10 @@ struct SpecializedEnv {
                        StepOutcome* out) {
     *out = env_step(kLatent, kVisual, *assets, episode_key, action, render != 0, *e);
   }
-  static HostEntryPoints entry_points() { return {abi_version, spec_hash, params, reset_env, step_env}; }
+  static void render_env(const AssetView* assets, Key episode_key, const EnvSlot* e) {
+    env_render(kLatent, kVisual, *assets, episode_key, *e);
+  }
+  static HostEntryPoints entry_points() { return {abi_version, spec_hash, params, reset_env, step_env, render_env}; }
 };
 
 }  // namespace kage
@@ -112,6 +116,10 @@ struct SpecializedEnv {
                                                                  const ::kage::EnvSlot* e,                  \
                                                                  ::kage::StepOutcome* out) {                \
     ::kage::SpecializedEnv<Cfg>::step_env(a, k, action, render, e, out);                                    \
+  }                                                                                                         \
+  __attribute__((visibility("default"))) void kage_host_render_env(const ::kage::AssetView* a, ::kage::Key k, \
+                                                                   const ::kage::EnvSlot* e) {              \
+    ::kage::SpecializedEnv<Cfg>::render_env(a, k, e);                                                       \
   }                                                                                                         \
   }
 #endif
