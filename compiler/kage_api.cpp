@@ -204,13 +204,16 @@ std::unique_ptr<Env> open_compiled_cpu(const fs::path& dir, const Json& manifest
 /// GPU over runtime/cuda: a fatbin, or NVRTC on the generated source.
 class GpuEnv final : public Env {
  public:
-  GpuEnv(CudaModule m, DeviceBatch b, AssetPack pack, int32_t H, int32_t W, std::string hash)
-      : module_(std::move(m)), pack_(std::move(pack)), batch_(std::move(b)), H_(H), W_(W), hash_(std::move(hash)) {}
+  GpuEnv(CUcontext ctx, CudaModule m, DeviceBatch b, AssetPack pack, int32_t H, int32_t W, std::string hash)
+      : ctx_(ctx), module_(std::move(m)), pack_(std::move(pack)), batch_(std::move(b)), H_(H), W_(W),
+        hash_(std::move(hash)) {}
+  // The members free device memory: in this batch's context, whichever thread drops the last reference.
+  ~GpuEnv() override { cuCtxSetCurrent(ctx_); }
   bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* e) override {
-    return no_pending_error(e) && batch_.reset(seeds, mask, e);
+    return bind(e) && no_pending_error(e) && batch_.reset(seeds, mask, e);
   }
   bool step(const Actions& a, std::string* e) override {
-    if (!no_pending_error(e)) return false;
+    if (!bind(e) || !no_pending_error(e)) return false;
     if (a.memory == Memory::kDevice) {
       if (a.dtype != DType::kInt32 && a.dtype != DType::kInt64) return fail(e, "kage: actions must be int32 or int64");
       return batch_.step(DeviceActions{reinterpret_cast<CUdeviceptr>(a.data), a.stride, a.dtype == DType::kInt64}, e);
@@ -234,23 +237,32 @@ class GpuEnv final : public Env {
   const uint8_t* final_mask() const override { return reinterpret_cast<const uint8_t*>(batch_.final_mask()); }
   const uint8_t* final_obs() const override { return reinterpret_cast<const uint8_t*>(batch_.final_obs()); }
   const void* final_info(InfoField f) const override { return info_column(batch_.final_info(), f); }
-  bool copy_obs(uint8_t* dst, std::string* e) const override { return batch_.download_obs(dst, e); }
-  bool synchronize(std::string* e) override { return batch_.synchronize(e) && no_pending_error(e); }
+  bool copy_obs(uint8_t* dst, std::string* e) const override { return bind(e) && batch_.download_obs(dst, e); }
+  bool synchronize(std::string* e) override { return bind(e) && batch_.synchronize(e) && no_pending_error(e); }
   std::string pending_error() override {
     const std::string problem = batch_.take_action_error();
     return problem.empty() ? problem : "kage: " + problem;
   }
-  bool save_state(std::vector<uint8_t>* out, std::string* e) const override { return batch_.save_state(hash_, out, e); }
+  bool save_state(std::vector<uint8_t>* out, std::string* e) const override {
+    return bind(e) && batch_.save_state(hash_, out, e);
+  }
   bool load_state(const uint8_t* data, size_t size, std::string* e) override {
-    return batch_.load_state(data, size, hash_, e) || fail(e, "kage: load_state: " + *e);
+    return bind(e) && (batch_.load_state(data, size, hash_, e) || fail(e, "kage: load_state: " + *e));
   }
 
  private:
+  /// Makes the batch's context current: the driver API acts on the calling thread's context, and the
+  /// caller may be another thread than the one that opened the batch.
+  bool bind(std::string* e) const {
+    const CUresult r = cuCtxSetCurrent(ctx_);
+    return r == CUDA_SUCCESS || fail(e, cu_error_text(r, "cuCtxSetCurrent"));
+  }
   bool no_pending_error(std::string* e) {
     const std::string problem = pending_error();
     return problem.empty() || fail(e, problem);
   }
 
+  CUcontext ctx_;
   CudaModule module_;
   AssetPack pack_;
   DeviceBatch batch_;
@@ -260,8 +272,9 @@ class GpuEnv final : public Env {
 };
 
 std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const std::string& fatbin, AssetPack pack,
-                              const Options& o, std::string* error) {
-  if (!cuda_primary_context(error)) return nullptr;
+                              const Options& o, std::string* error, ErrorKind* kind) {
+  const CUcontext ctx = cuda_primary_context(error);
+  if (!ctx) return *kind = ErrorKind::kDevice, nullptr;
   std::optional<CudaModule> m;
   if (!fatbin.empty() && fs::exists(fatbin)) {
     m = CudaModule::load_file(fatbin, error);
@@ -275,10 +288,57 @@ std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const 
   auto b = DeviceBatch::create(*m, l.config.latent, l.config.visual, pack.view(), o.num_envs, error);
   if (!b) return nullptr;
   b->set_stream(static_cast<CUstream>(o.stream));
-  return std::make_unique<GpuEnv>(std::move(*m), std::move(*b), std::move(pack), l.config.visual.H, l.config.visual.W,
+  return std::make_unique<GpuEnv>(ctx, std::move(*m), std::move(*b), std::move(pack), l.config.visual.H, l.config.visual.W,
                                   l.spec_hash);
 }
 #endif
+
+/// open() without the final error kind: sets *kind where a failure has a specific one.
+std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::string* error, ErrorKind* kind) {
+  if (o.num_envs <= 0 || o.num_threads <= 0)
+    return *kind = ErrorKind::kUsage, fail(error, "kage::open: num_envs and num_threads must be positive"), nullptr;
+#if !defined(KAGE_API_HAVE_CUDA)
+  if (o.backend == Backend::kGpu)
+    return *kind = ErrorKind::kDevice, fail(error, "kage::open: GPU backend not built (no CUDA toolkit at build time)"), nullptr;
+#endif
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    const fs::path dir(path);
+    const auto text = read_file(dir / "manifest.json");
+    *kind = ErrorKind::kFile;
+    if (!text) return fail(error, "kage::open: no manifest.json in '" + path + "' (write one with kagec compile)"), nullptr;
+    const Json manifest = Json::parse(*text, nullptr, false);
+    if (manifest.is_discarded() || manifest.value("kagec_manifest", 0) != 1)
+      return fail(error, "kage::open: '" + path + "/manifest.json' is not a kagec manifest"), nullptr;
+    if (o.backend == Backend::kCpu) return open_compiled_cpu(dir, manifest, o, error);
+    *kind = ErrorKind::kOther;
+#if defined(KAGE_API_HAVE_CUDA)
+    const auto params = read_file(dir / "params.bin");
+    const auto source = read_file(dir / manifest.value("source", ""));
+    const auto blob = read_file(dir / "assets.bin");
+    std::optional<AssetPack> pack = blob ? deserialize_asset_pack(*blob) : std::nullopt;
+    if (!params || params->size() != sizeof(LatentParams) + sizeof(VisualParams) || !source || !pack)
+      return fail(error, "kage::open: '" + path + "' lacks params.bin, its source or assets.bin"), nullptr;
+    Loaded l{manifest.value("spec_sha256", ""), {}};
+    std::memcpy(&l.config.latent, params->data(), sizeof(LatentParams));
+    std::memcpy(&l.config.visual, params->data() + sizeof(LatentParams), sizeof(VisualParams));
+    return open_gpu(l, *source, (dir / "kernels.fatbin").string(), std::move(*pack), o, error, kind);
+#endif
+  }
+  std::optional<Loaded> l = load_yaml(path, o, error);
+  if (!l) return *kind = ErrorKind::kConfig, nullptr;
+  AssetPackResult assets = load_asset_pack(l->config.assets);
+  if (!assets.ok()) return fail(error, "kage::open: " + assets.error), nullptr;
+  if (o.backend == Backend::kCpu)
+    return std::make_unique<HostEnv>(nullptr, generic_host_kernels(l->config.latent, l->config.visual),
+                                     std::move(*assets.pack), o, l->spec_hash);
+#if defined(KAGE_API_HAVE_CUDA)
+  const GeneratedSource g = generate_source({l->spec_hash, l->config.latent, l->config.visual});
+  return open_gpu(*l, g.text, "", std::move(*assets.pack), o, error, kind);
+#else
+  return nullptr;
+#endif
+}
 
 }  // namespace
 
@@ -295,49 +355,13 @@ bool gpu_backend_built() {
 #endif
 }
 
-std::unique_ptr<Env> open(const std::string& path, const Options& o, std::string* error) {
-  if (o.num_envs <= 0 || o.num_threads <= 0) return fail(error, "kage::open: num_envs and num_threads must be positive"), nullptr;
-#if !defined(KAGE_API_HAVE_CUDA)
-  if (o.backend == Backend::kGpu) return fail(error, "kage::open: GPU backend not built (no CUDA toolkit at build time)"), nullptr;
-#endif
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) {
-    const fs::path dir(path);
-    const auto text = read_file(dir / "manifest.json");
-    if (!text) return fail(error, "kage::open: no manifest.json in '" + path + "' (write one with kagec compile)"), nullptr;
-    const Json manifest = Json::parse(*text, nullptr, false);
-    if (manifest.is_discarded() || manifest.value("kagec_manifest", 0) != 1)
-      return fail(error, "kage::open: '" + path + "/manifest.json' is not a kagec manifest"), nullptr;
-    if (o.backend == Backend::kCpu) return open_compiled_cpu(dir, manifest, o, error);
-#if defined(KAGE_API_HAVE_CUDA)
-    const auto params = read_file(dir / "params.bin");
-    const auto source = read_file(dir / manifest.value("source", ""));
-    const auto blob = read_file(dir / "assets.bin");
-    std::optional<AssetPack> pack = blob ? deserialize_asset_pack(*blob) : std::nullopt;
-    if (!params || params->size() != sizeof(LatentParams) + sizeof(VisualParams) || !source || !pack)
-      return fail(error, "kage::open: '" + path + "' lacks params.bin, its source or assets.bin"), nullptr;
-    Loaded l{manifest.value("spec_sha256", ""), {}};
-    std::memcpy(&l.config.latent, params->data(), sizeof(LatentParams));
-    std::memcpy(&l.config.visual, params->data() + sizeof(LatentParams), sizeof(VisualParams));
-    return open_gpu(l, *source, (dir / "kernels.fatbin").string(), std::move(*pack), o, error);
-#endif
-  }
-  std::optional<Loaded> l = load_yaml(path, o, error);
-  if (!l) return nullptr;
-  if (o.backend == Backend::kCpu) {
-    AssetPackResult assets = load_asset_pack(l->config.assets);
-    if (!assets.ok()) return fail(error, "kage::open: " + assets.error), nullptr;
-    return std::make_unique<HostEnv>(nullptr, generic_host_kernels(l->config.latent, l->config.visual),
-                                     std::move(*assets.pack), o, l->spec_hash);
-  }
-#if defined(KAGE_API_HAVE_CUDA)
-  AssetPackResult assets = load_asset_pack(l->config.assets);
-  if (!assets.ok()) return fail(error, "kage::open: " + assets.error), nullptr;
-  const GeneratedSource g = generate_source({l->spec_hash, l->config.latent, l->config.visual});
-  return open_gpu(*l, g.text, "", std::move(*assets.pack), o, error);
-#else
-  return nullptr;
-#endif
+std::unique_ptr<Env> open(const std::string& path, const Options& o, std::string* error, ErrorKind* kind_out) {
+  ErrorKind ignored = ErrorKind::kOther;
+  ErrorKind* kind = kind_out ? kind_out : &ignored;
+  *kind = ErrorKind::kOther;
+  std::unique_ptr<Env> env = open_any(path, o, error, kind);
+  if (env) *kind = ErrorKind::kNone;
+  return env;
 }
 
 }  // namespace kage

@@ -144,8 +144,20 @@ class Env {
   [[nodiscard]] virtual bool load_state(const uint8_t* data, size_t size, std::string* error = nullptr) = 0;
 };
 
-/// Opens `path`: a directory with manifest.json (from `kagec compile`) or a YAML config. Null on error.
-std::unique_ptr<Env> open(const std::string& path, const Options& options, std::string* error);
+/// What an open() failure was about.
+enum class ErrorKind {
+  kNone,
+  kConfig,  ///< the config has errors: the message holds the located diagnostics (file:line:col)
+  kFile,    ///< a compiled directory is missing a file or is not one
+  kDevice,  ///< no usable GPU (no driver, no device, or a build without the GPU backend)
+  kUsage,   ///< an option is out of range
+  kOther,
+};
+
+/// Opens `path`: a directory with manifest.json (from `kagec compile`) or a YAML config. Null on error,
+/// with the message in `error` and its kind in `kind` (if given).
+std::unique_ptr<Env> open(const std::string& path, const Options& options, std::string* error,
+                          ErrorKind* kind = nullptr);
 
 /// Whether this build can run the GPU backend (the CUDA runtime pieces were compiled in).
 bool gpu_backend_built();

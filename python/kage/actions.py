@@ -1,0 +1,87 @@
+"""Hands a step's actions to the runtime without a copy where the runtime can read them in place.
+
+Accepted: numpy arrays and sequences of ints (host); anything with ``__dlpack__`` (torch, JAX, CuPy,
+numpy ...), read in place when it lives on the GPU and the environment does too; anything with
+``__cuda_array_interface__`` (Numba, CuPy, torch). Shape ``(num_envs,)``, an integer dtype; on the GPU
+int32 or int64. Host actions are checked to be in 0..7 before the step. Device actions are checked by
+the step kernel, and an out-of-range value raises ``ValueError`` at a later call (checking at once
+would wait for the GPU).
+"""
+import numpy as np
+
+from kage import _kage
+
+_DLPACK_CPU, _DLPACK_CUDA, _DLPACK_CUDA_HOST, _DLPACK_CUDA_MANAGED = 1, 2, 3, 13
+_RANGE = "an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump)"
+
+
+def submit(handle: "_kage.Env", actions) -> None:
+    """Steps ``handle`` with ``actions``; raises ValueError for a wrong shape, dtype, device or value."""
+    n = handle.num_envs
+    if hasattr(actions, "__dlpack_device__"):
+        device_type, _ = actions.__dlpack_device__()
+        if device_type in (_DLPACK_CUDA, _DLPACK_CUDA_MANAGED):
+            _require_cuda_env(handle, actions)
+            _check_shape(getattr(actions, "shape", None), n)
+            # The producer orders its pending work before our stream (DLPack protocol, 1 = legacy default).
+            stream = handle.stream or 1
+            handle.step_dlpack(actions.__dlpack__(stream=stream))
+            return
+        if device_type in (_DLPACK_CPU, _DLPACK_CUDA_HOST):
+            _step_host(handle, _host_array(actions), n)
+            return
+        raise ValueError(f"actions on DLPack device type {device_type}: pass them in host or CUDA memory")
+    if hasattr(actions, "__cuda_array_interface__"):
+        _require_cuda_env(handle, actions)
+        _step_cuda_array_interface(handle, actions.__cuda_array_interface__, n)
+        return
+    _step_host(handle, np.asarray(actions), n)
+
+
+def _host_array(actions) -> np.ndarray:
+    if isinstance(actions, np.ndarray):
+        return actions
+    try:
+        return np.from_dlpack(actions)
+    except (BufferError, RuntimeError, TypeError) as e:
+        raise ValueError(f"actions could not be read through DLPack ({e}); pass a numpy array") from e
+
+
+def _require_cuda_env(handle, actions) -> None:
+    if handle.device != "cuda":
+        raise ValueError(
+            f"actions are in GPU memory ({type(actions).__name__}) but the environment runs on the CPU: "
+            "pass host actions (e.g. actions.cpu()) or make the environment with device='cuda'"
+        )
+
+
+def _check_shape(shape, n: int) -> None:
+    if shape is not None and tuple(shape) != (n,):
+        raise ValueError(f"actions of shape {tuple(shape)}, expected ({n},): one action per environment")
+
+
+def _step_host(handle, a: np.ndarray, n: int) -> None:
+    _check_shape(a.shape, n)
+    if a.dtype.kind not in "iu":
+        raise ValueError(f"actions of dtype {a.dtype}, expected an integer dtype (int32 or int64): {_RANGE}")
+    if a.size:
+        bad = np.flatnonzero((a < 0) | (a > 7))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(f"action {a[i]} for environment {i}: {_RANGE}")
+    if a.dtype not in (np.int32, np.int64):
+        a = a.astype(np.int32)
+    handle.step_host(a)
+
+
+def _step_cuda_array_interface(handle, cai: dict, n: int) -> None:
+    _check_shape(cai["shape"], n)
+    typestr = cai["typestr"]
+    if typestr not in ("<i4", "<i8"):
+        raise ValueError(f"actions of type {typestr}, expected int32 (<i4) or int64 (<i8) on the GPU")
+    itemsize = int(typestr[-1])
+    strides = cai.get("strides")
+    stride = 1 if strides is None else strides[0] // itemsize
+    ptr, _ = cai["data"]
+    stream = cai.get("stream")
+    handle.step_device(ptr, itemsize == 8, stride, -1 if stream is None else stream)

@@ -1,0 +1,208 @@
+"""VecEnv: a batch of KAGE environments with Gymnasium 1.x's vector signatures (same-step autoreset).
+
+Outputs are views of the runtime's memory, not copies: numpy arrays on the CPU, ``kage.DeviceArray`` on
+the GPU (take them with ``torch.from_dlpack``, ``jax.dlpack.from_dlpack`` or ``cupy.asarray``). A view
+stays allocated while it exists, but its contents are overwritten by the next ``reset`` or ``step``:
+copy what you keep (``obs.copy()``, ``tensor.clone()``).
+"""
+import os
+from typing import Any, Dict, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from kage import _kage, actions as _actions, spaces
+from kage.errors import ConfigError, DeviceUnavailableError
+
+_kage.set_open_errors(ConfigError, FileNotFoundError, DeviceUnavailableError, ValueError, RuntimeError)
+
+#: (name, numpy dtype, meaning) of every info field, in the runtime's order.
+INFO_FIELDS = tuple(_kage.info_fields())
+
+Seed = Union[int, Sequence[int], None]
+
+
+def env_seeds(seed: int, num_envs: int) -> np.ndarray:
+    """The per-environment seeds of ``reset(seed=seed)``: independent 64-bit draws of numpy's
+    ``SeedSequence(seed)``, so runs with different seeds share no environment stream."""
+    return np.random.SeedSequence(seed).generate_state(num_envs, dtype=np.uint64)
+
+
+def _explicit_seeds(seed, num_envs: int) -> np.ndarray:
+    """num_envs integers in [0, 2^64) as uint64 (Python ints above 2^63 would become float64 in numpy)."""
+    values = list(seed)
+    if len(values) != num_envs or not all(isinstance(v, (int, np.integer)) and 0 <= int(v) < 2**64 for v in values):
+        raise ValueError(f"seed: an int or {num_envs} non-negative ints below 2**64, got {seed!r:.80}")
+    return np.array([int(v) for v in values], dtype=np.uint64)
+
+
+class VecEnv:
+    """``num_envs`` environments of one configuration, stepped together.
+
+    ``reset(seed=None, options=None) -> (obs, info)`` and
+    ``step(actions) -> (obs, reward, terminated, truncated, info)``: obs uint8 [N, H, W, 3], reward
+    float32 [N], terminated and truncated uint8 0/1 [N] (``.astype(bool)`` / ``.bool()``: DLPack 0.6,
+    numpy 1.24 and torch 1.13 share no bool type), info a dict of [N] arrays named as the original's
+    info (``x``, ``y``, ``vx``, ``vy``, ``vx_mean``, ``vy_mean``, ``timestep``, ``passed_distance``,
+    ``progress``, ``success``, ``success_once``, ``jump_count``, ``return``, ``length``).
+
+    Same-step autoreset: when a step ends an episode, that environment starts its next episode in the
+    same step. The step returns the finishing step's reward and flags, the new episode's first
+    observation and info, and the finished episode in ``info["final_obs"]`` and ``info["final_info"]``
+    (a dict of the same fields), where ``info["_final"]`` is 1. Rows where ``_final`` is 0 are stale.
+    """
+
+    metadata = {"autoreset_mode": "same-step"}
+
+    def __init__(self, handle: "_kage.Env", config: str, seed: int):
+        self._handle = handle
+        self.config = config
+        self.num_envs = handle.num_envs
+        self.device = handle.device
+        self.spec_hash = handle.spec_hash
+        self.single_observation_space = spaces.observation_space(handle.height, handle.width)
+        self.single_action_space = spaces.action_space()
+        self._seed = seed
+        self._resets_without_seed = 0
+        self._last_actions = None
+        out = handle.output
+        self._obs = out("obs")
+        self._reward = out("reward")
+        self._terminated = out("terminated")
+        self._truncated = out("truncated")
+        self._info = {name: out(f"info/{name}") for name, _, _ in INFO_FIELDS}
+        final_mask = out("final_mask")
+        final_info = {name: out(f"final_info/{name}") for name, _, _ in INFO_FIELDS}
+        # Gymnasium 1.x same-step keys; _final_obs and _final_info are the same mask as _final.
+        self._final = {
+            "final_obs": out("final_obs"),
+            "final_info": final_info,
+            "_final": final_mask,
+            "_final_obs": final_mask,
+            "_final_info": final_mask,
+        }
+
+    # ---- Gymnasium vector API ----
+
+    def reset(self, seed: Seed = None, options: Optional[Dict[str, Any]] = None) -> Tuple[Any, Dict[str, Any]]:
+        """Starts episode 0 of every environment (or of those where ``options["reset_mask"]`` is true;
+        the others keep their state). ``seed``: an int (each environment gets its own seed from it,
+        see ``env_seeds``), ``num_envs`` ints (the environments' own seeds), or None (make_vec's seed
+        on the first call, then a fresh draw from it on each later call)."""
+        handle = self._live()
+        if seed is None:
+            seeds = np.random.SeedSequence([self._seed, self._resets_without_seed]).generate_state(
+                self.num_envs, dtype=np.uint64) if self._resets_without_seed else env_seeds(self._seed, self.num_envs)
+            self._resets_without_seed += 1
+        elif np.ndim(seed) == 0:
+            seeds = env_seeds(int(seed), self.num_envs)
+        else:
+            seeds = _explicit_seeds(seed, self.num_envs)
+        mask = None
+        options = dict(options or {})
+        if "reset_mask" in options:
+            mask = np.asarray(options.pop("reset_mask"))
+            if mask.shape != (self.num_envs,):
+                raise ValueError(f"options['reset_mask']: expected {self.num_envs} booleans, got shape {mask.shape}")
+            mask = mask.astype(np.uint8)
+        if options:
+            raise ValueError(f"reset: unknown options {sorted(options)} (known: 'reset_mask')")
+        handle.reset(seeds, mask)
+        return self._obs, self._info_dict()
+
+    def step(self, actions) -> Tuple[Any, Any, Any, Any, Dict[str, Any]]:
+        """One step of every environment; ``actions``: [num_envs] integers in 0..7 (numpy, torch,
+        JAX, CuPy, ...; read in place on the GPU)."""
+        handle = self._live()
+        _actions.submit(handle, actions)
+        # The runtime reads device actions when its kernel runs: keep them alive until the next step.
+        self._last_actions = actions
+        return self._obs, self._reward, self._terminated, self._truncated, self._info_dict()
+
+    def close(self) -> None:
+        """Releases the environments. Arrays and tensors still viewing their outputs keep that memory
+        alive until they are dropped. Closing twice is harmless; any other use raises."""
+        if self._handle is not None:
+            self._handle.close()
+        self._handle = None
+        self._obs = self._reward = self._terminated = self._truncated = self._info = self._final = None
+        self._last_actions = None
+
+    def __enter__(self) -> "VecEnv":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # ---- beyond Gymnasium ----
+
+    def save_state(self) -> bytes:
+        """The whole batch's state and last outputs (about 1.4 KB per environment); waits for queued
+        work. ``load_state`` on a batch of the same config and size, on either device, continues
+        exactly as this one would."""
+        return self._live().save_state()
+
+    def load_state(self, state: bytes) -> Tuple[Any, Dict[str, Any]]:
+        """Restores ``save_state``'s bytes and returns the restored (obs, info)."""
+        self._live().load_state(state)
+        return self._obs, self._info_dict()
+
+    def synchronize(self) -> None:
+        """Waits for the batch's queued GPU work; raises ValueError if an earlier step had an
+        out-of-range device action."""
+        self._live().synchronize()
+
+    @property
+    def stream(self) -> int:
+        """The CUstream handle the batch queues its work on (0: the legacy default stream)."""
+        return self._live().stream
+
+    @property
+    def closed(self) -> bool:
+        return self._handle is None
+
+    def __repr__(self) -> str:
+        state = "closed" if self.closed else f"{self.num_envs} envs on {self.device}"
+        return f"<kage.VecEnv {self.config!r}, {state}, spec {self.spec_hash[:12]}>"
+
+    def _live(self) -> "_kage.Env":
+        if self._handle is None:
+            raise RuntimeError("this environment is closed: make a new one with kage.make_vec")
+        return self._handle
+
+    def _info_dict(self) -> Dict[str, Any]:
+        info = dict(self._info)
+        info.update(self._final)
+        return info
+
+
+def make_vec(config: Union[str, os.PathLike], num_envs: int, device: str = "cpu", seed: int = 0,
+             asset_root: Optional[str] = None, threads: Optional[int] = None, stream=None) -> VecEnv:
+    """A batch of ``num_envs`` environments of ``config`` (a YAML file or a ``kagec compile``
+    directory) on ``device`` ("cpu" or "cuda").
+
+    ``seed`` seeds ``reset()`` calls without a seed. ``asset_root`` resolves the config's asset paths
+    (default: relative to the file that names them). ``threads``: CPU worker threads (default: one
+    per core; results do not depend on it). ``stream``: GPU only, the CUDA stream the batch queues its
+    work on (a ``torch.cuda.Stream``, or a CUstream handle); default the legacy default stream, which
+    orders with PyTorch's default stream, so a learner on that stream needs no synchronisation.
+
+    Raises ``kage.ConfigError`` (with kagec's located diagnostics) for a config with errors,
+    ``FileNotFoundError`` for a missing config, ``RuntimeError`` for ``device="cuda"`` without a usable
+    GPU, ``ValueError`` for bad arguments.
+    """
+    config = os.fspath(config)
+    if device not in ("cpu", "cuda"):
+        raise ValueError(f"device={device!r}: use 'cpu' or 'cuda'")
+    if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs <= 0:
+        raise ValueError(f"num_envs={num_envs!r}: a positive integer")
+    if not os.path.exists(config):
+        raise FileNotFoundError(f"config '{config}' not found (a YAML file or a kagec compile directory)")
+    if threads is None:
+        threads = min(int(num_envs), os.cpu_count() or 1)
+    if threads <= 0:
+        raise ValueError(f"threads={threads}: a positive integer")
+    if device == "cpu" and stream is not None:
+        raise ValueError("stream= is for device='cuda'")
+    stream_handle = 0 if stream is None else int(getattr(stream, "cuda_stream", stream))
+    handle = _kage.open(config, int(num_envs), device, int(threads), asset_root or "", stream_handle)
+    return VecEnv(handle, config, int(seed))

@@ -1,0 +1,89 @@
+"""make_vec's result: shapes, dtypes, spaces, metadata, seeding and subset reset."""
+import numpy as np
+import pytest
+
+import kage
+from conftest import NEAR_GOAL, SIMPLEST, policy
+
+
+def test_shapes_and_dtypes():
+    with kage.make_vec(SIMPLEST, 3) as env:
+        obs, info = env.reset(seed=0)
+        assert obs.shape == (3, 128, 128, 3) and obs.dtype == np.uint8
+        obs, reward, terminated, truncated, info = env.step(np.array([2, 6, 0]))
+        assert reward.shape == (3,) and reward.dtype == np.float32
+        assert terminated.dtype == np.uint8 and truncated.dtype == np.uint8
+        expected = {name: dtype for name, dtype, _ in kage.INFO_FIELDS}
+        assert set(expected) == {"x", "y", "vx", "vy", "vx_mean", "vy_mean", "timestep", "passed_distance",
+                                 "progress", "success", "success_once", "jump_count", "return", "length"}
+        for name, dtype in expected.items():
+            assert info[name].shape == (3,) and info[name].dtype == dtype, name
+        assert info["final_obs"].shape == (3, 128, 128, 3)
+        assert set(info["final_info"]) == set(expected)
+        assert info["_final"].dtype == np.uint8 and not info["_final"].any()
+        assert info["timestep"].tolist() == [1, 1, 1] and info["length"].tolist() == [1, 1, 1]
+        assert obs.any(), "the frame is not blank"
+
+
+def test_spaces_and_metadata():
+    with kage.make_vec(SIMPLEST, 2) as env:
+        assert env.num_envs == 2
+        assert env.metadata["autoreset_mode"] == "same-step"
+        assert env.single_observation_space.shape == (128, 128, 3)
+        assert env.single_observation_space.dtype == np.uint8
+        assert env.single_action_space.n == 8
+        assert len(env.spec_hash) == 64 and int(env.spec_hash, 16) >= 0
+
+
+def test_seeds_give_distinct_levels_and_repeat():
+    with kage.make_vec(SIMPLEST, 4) as a, kage.make_vec(SIMPLEST, 4) as b:
+        oa = a.reset(seed=3)[0].copy()
+        ob, _ = b.reset(seed=3)
+        assert np.array_equal(oa, ob)
+        assert len({oa[i].tobytes() for i in range(4)}) == 4, "each environment has its own level"
+        ob, _ = b.reset(seed=4)
+        assert not np.array_equal(oa, ob)
+        explicit, _ = b.reset(seed=kage.env_seeds(3, 4).tolist())
+        assert np.array_equal(oa, explicit)
+
+
+def test_reset_without_seed_follows_make_vec_seed():
+    with kage.make_vec(SIMPLEST, 2, seed=9) as a, kage.make_vec(SIMPLEST, 2) as b:
+        first = a.reset()[0].copy()
+        assert np.array_equal(first, b.reset(seed=9)[0])
+        second, _ = a.reset()
+        assert not np.array_equal(second, first), "a later reset() starts other levels"
+
+
+def test_reset_mask_resets_only_masked_envs():
+    actions = policy(1, 3, 20)
+    with kage.make_vec(NEAR_GOAL, 3) as env:
+        env.reset(seed=5)
+        for a in actions:
+            env.step(a)
+        before_x = env.step(actions[0])[4]["x"].copy()
+        obs, info = env.reset(seed=[11, 12, 13], options={"reset_mask": np.array([False, True, False])})
+        assert info["timestep"].tolist() == [21, 0, 21]
+        assert info["x"][0] == before_x[0] and info["x"][2] == before_x[2]
+        with kage.make_vec(NEAR_GOAL, 3) as fresh:
+            fresh_obs, _ = fresh.reset(seed=[11, 12, 13])
+            assert np.array_equal(obs[1], fresh_obs[1]), "the masked environment starts episode 0 of its new seed"
+
+
+def test_context_manager_closes():
+    with kage.make_vec(SIMPLEST, 1) as env:
+        env.reset(seed=0)
+    assert env.closed
+    with pytest.raises(RuntimeError, match="closed"):
+        env.step(np.zeros(1, dtype=np.int64))
+    with pytest.raises(RuntimeError, match="closed"):
+        env.reset()
+    env.close()  # a second close is harmless
+
+
+def test_views_outlive_close():
+    env = kage.make_vec(SIMPLEST, 2)
+    obs, _ = env.reset(seed=0)
+    expected = obs.copy()
+    env.close()
+    assert np.array_equal(obs, expected), "an output view keeps the runtime's memory alive"
