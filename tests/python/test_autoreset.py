@@ -7,7 +7,7 @@ steps, and at step 500 it shows the frame and info that the 500-step config move
 import numpy as np
 
 import kage
-from conftest import LONG_EPISODE, NEAR_GOAL, SIMPLEST, policy
+from support import LONG_EPISODE, NEAR_GOAL, SIMPLEST, policy
 
 SEEDS = [21, 22, 23]
 

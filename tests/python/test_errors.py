@@ -4,7 +4,7 @@ import pytest
 import torch
 
 import kage
-from conftest import CONFIGS, SIMPLEST
+from support import CONFIGS, SIMPLEST
 
 
 @pytest.fixture

@@ -2,7 +2,7 @@
 import numpy as np
 
 import kage
-from conftest import NEAR_GOAL, policy
+from support import NEAR_GOAL, policy
 
 DIST_TO_SUCCESS = np.float32(12.0)  # tests/python/configs/near_goal.yaml
 

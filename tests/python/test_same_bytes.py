@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import kage
-from conftest import NEAR_GOAL, NOISY_SKELETON
+from support import NEAR_GOAL, NOISY_SKELETON
 
 STEPS = 45  # past near_goal's 40-step episodes: one automatic reset
 

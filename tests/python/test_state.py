@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import kage
-from conftest import NEAR_GOAL, NOISY_SKELETON, SIMPLEST, policy
+from support import NEAR_GOAL, NOISY_SKELETON, SIMPLEST, policy
 
 
 def run(env, actions):

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import kage
-from conftest import NEAR_GOAL, SIMPLEST, policy
+from support import NEAR_GOAL, SIMPLEST, policy
 
 
 def test_shapes_and_dtypes():

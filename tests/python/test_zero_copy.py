@@ -3,7 +3,7 @@ import numpy as np
 import torch
 
 import kage
-from conftest import SIMPLEST
+from support import SIMPLEST
 
 
 def test_numpy_and_torch_share_the_runtime_memory():

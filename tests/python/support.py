@@ -1,0 +1,18 @@
+"""Paths and a deterministic policy shared by the Python tests (tests/python, tests/gpu)."""
+import pathlib
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+CONFIGS = pathlib.Path(__file__).resolve().parent / "configs"
+SIMPLEST = str(ROOT / "configs/throughput/simplest.yaml")
+LONG_EPISODE = str(CONFIGS / "long_episode.yaml")
+NEAR_GOAL = str(CONFIGS / "near_goal.yaml")
+# A config with a stochastic filter, sprites and short episodes.
+NOISY_SKELETON = str(CONFIGS / "noisy_short.yaml")
+
+
+def policy(seed: int, num_envs: int, steps: int) -> np.ndarray:
+    """[steps, num_envs] actions, mostly right and right+jump, so that the agent travels and lands."""
+    rng = np.random.default_rng(seed)
+    return rng.choice(np.array([2, 6, 2, 6, 0, 1, 4, 7], dtype=np.int64), size=(steps, num_envs))
