@@ -160,7 +160,9 @@ class SuiteLoader {
     }
     for_each_item(*evals, [&](const DocNode& ev) {
       SuitePair p;
-      p.name = name + "/" + text_of(ev, "name", true);
+      p.sweep = name;
+      p.sweep_eval = text_of(ev, "name", true);
+      p.name = name + "/" + p.sweep_eval;
       p.range = ev.range;
       auto config = config_of(ev, "config", suite);
       if (!axis || !train || !config) return;
@@ -281,6 +283,8 @@ Json suite_report_json(const Suite& suite, const SuiteReport& report) {
     const PairIdentity eval{r.pair->eval.label(), r.eval ? r.eval->sha256() : ""};
     Json j = certificate_json(train, eval, r.diff, r.cert);
     j["pair"] = r.pair->name;
+    j["sweep"] = r.pair->sweep.empty() ? Json() : Json(r.pair->sweep);
+    j["sweep_eval"] = r.pair->sweep.empty() ? Json() : Json(r.pair->sweep_eval);
     j["lint_ok"] = r.lint_ok;
     j["warnings"] = r.warnings;
     pairs.push_back(j);

@@ -23,6 +23,8 @@ struct ConfigRef {
 
 struct SuitePair {
   std::string name;
+  std::string sweep;       // the sweep this pair belongs to (empty for a plain pair)
+  std::string sweep_eval;  // its eval's name within the sweep
   Axis axis = Axis::Background;
   ConfigRef train, eval;
   std::vector<Allowance> allow;

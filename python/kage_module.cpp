@@ -16,6 +16,7 @@
 
 #include "kage/kage.h"
 #include "python/cuda_streams.h"
+#include "python/front_end.h"
 
 namespace py = pybind11;
 
@@ -393,6 +394,13 @@ PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& dev
   throw py::error_already_set();
 }
 
+/// The JSON of a front-end call, or its diagnostics raised as the config error class.
+std::string front_end_json(const kage::python::FrontEndResult& r) {
+  if (r.ok()) return r.json;
+  PyErr_SetObject(open_errors().config.ptr(), py::str(r.error).ptr());
+  throw py::error_already_set();
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_kage, m) {
@@ -418,6 +426,16 @@ PYBIND11_MODULE(_kage, m) {
       "Exception classes open() raises for a config, file, device, usage and any other error.");
 
   m.def("gpu_backend_built", &kage::gpu_backend_built);
+  m.def("resolve", [](const std::string& path, const std::string& asset_root) {
+    return front_end_json(kage::python::resolve_config_json(path, asset_root));
+  }, py::arg("path"), py::arg("asset_root") = "", "kagec resolve: the canonical Spec as JSON text.");
+  m.def("certify", [](const std::string& train, const std::string& eval, const std::string& asset_root) {
+    return front_end_json(kage::python::certify_pair_json(train, eval, asset_root));
+  }, py::arg("train"), py::arg("eval"), py::arg("asset_root") = "",
+     "kagec diff --certify: the pair's certificate as JSON text.");
+  m.def("suite_report", [](const std::string& manifest) {
+    return front_end_json(kage::python::suite_report(manifest));
+  }, py::arg("manifest"), "kagec suite: the report of a manifest (pairs, sweeps, certificates) as JSON text.");
   m.def("info_fields", [] {
     int32_t count = 0;
     const kage::InfoFieldDesc* fields = kage::info_fields(&count);

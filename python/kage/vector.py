@@ -118,6 +118,12 @@ class VecEnv:
         self._last_actions = actions
         return self._obs, self._reward, self._terminated, self._truncated, self._info_dict()
 
+    def outputs(self) -> Tuple[Any, Any, Any, Any, Dict[str, Any]]:
+        """The arrays of the last reset or step, (obs, reward, terminated, truncated, info), without
+        stepping: the same views every call, so a learner can take them once and read them each step."""
+        self._live()
+        return self._obs, self._reward, self._terminated, self._truncated, self._info_dict()
+
     def close(self) -> None:
         """Releases the environments. Arrays and tensors still viewing their outputs keep that memory
         alive until they are dropped. Closing twice is harmless; any other use raises."""

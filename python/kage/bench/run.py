@@ -1,0 +1,224 @@
+"""python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [trainer flags]
+
+Trains every (pair, seed) of a suite manifest with `python3 -m kage.train`, one run after the other, each
+in its own process and run directory:
+
+    DIR/suite.json                  the suite's report (kagec suite): pairs, axes, paths, spec hashes, certificates
+    DIR/bench.json                  the manifest, the seeds asked for so far and the trainer flags
+    DIR/runs/<pair>/seed_<s>/       a training run (kage.train's run directory) and its train.log
+
+A plain pair trains on its train config and evaluates on its eval config (label "eval"). A sweep (one
+train config, several evals) runs once per seed and evaluates every eval config of the sweep (labels:
+the evals' names). Running again on the same DIR skips finished runs, resumes unfinished ones from their
+checkpoints, and never overwrites a result; it refuses other trainer flags, and a config whose Spec
+changed since DIR was started.
+"""
+import argparse
+import dataclasses
+import difflib
+import json
+import os
+import re
+import subprocess
+import sys
+import time
+from typing import Dict, List, Optional
+
+from kage import _kage
+from kage.errors import ConfigError
+from kage.rundir import write_json
+
+
+@dataclasses.dataclass
+class Unit:
+    """One trained thing per seed: a plain pair, or a whole sweep."""
+
+    name: str
+    axis: str
+    train: str
+    evals: List[str]
+    labels: List[str]
+
+
+def parse_seeds(text: str) -> List[int]:
+    """"1-10", "1,3,5" or "7"."""
+    seeds: List[int] = []
+    for part in text.split(","):
+        m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
+        if not m:
+            raise SystemExit(f"kage.bench run: --seeds {text!r}: use a range like 1-10, a list like 1,3,5, or one seed")
+        first, last = int(m[1]), int(m[2] or m[1])
+        if last < first:
+            raise SystemExit(f"kage.bench run: --seeds {text!r}: the range {first}-{last} is empty")
+        seeds.extend(range(first, last + 1))
+    return sorted(set(seeds))
+
+
+def units_of(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
+    """The suite's pairs and sweeps, in manifest order, or the `wanted` ones."""
+    units: Dict[str, Unit] = {}
+    for p in report["pairs"]:
+        if p["train"]["name"] == "(inline)" or p["eval"]["name"] == "(inline)":
+            raise SystemExit(f"kage.bench run: pair {p['pair']} writes a config inline in the manifest; "
+                             "kage.bench trains only configs in files: move it to a file")
+        if p["sweep"] is None:
+            units[p["pair"]] = Unit(p["pair"], p["declared_axis"], p["train"]["name"], [p["eval"]["name"]], ["eval"])
+        else:
+            unit = units.setdefault(p["sweep"], Unit(p["sweep"], p["declared_axis"], p["train"]["name"], [], []))
+            unit.evals.append(p["eval"]["name"])
+            unit.labels.append(p["sweep_eval"])
+    if not wanted:
+        return list(units.values())
+    chosen = []
+    for name in wanted:
+        if name in units:
+            chosen.append(units[name])
+            continue
+        sweep = next((u.name for u in units.values() if name.startswith(u.name + "/") and len(u.evals) > 1), None)
+        if sweep:
+            raise SystemExit(f"kage.bench run: {name} is one eval of the sweep '{sweep}'; select the sweep as a whole")
+        close = difflib.get_close_matches(name, units, n=3)
+        hint = f"; did you mean {', '.join(close)}?" if close else f"; the suite has {', '.join(list(units)[:6])} ..."
+        raise SystemExit(f"kage.bench run: no pair or sweep named '{name}' in the suite{hint}")
+    return chosen
+
+
+def check_suite_unchanged(out: str, report: dict) -> None:
+    """Refuses a DIR started on configs whose Specs have changed since."""
+    path = os.path.join(out, "suite.json")
+    if not os.path.exists(path):
+        return
+    with open(path) as f:
+        before = {p["pair"]: p for p in json.load(f)["pairs"]}
+    for p in report["pairs"]:
+        old = before.get(p["pair"])
+        if old is None:
+            continue
+        for side in ("train", "eval"):
+            if old[side]["spec_sha256"] != p[side]["spec_sha256"]:
+                raise SystemExit(
+                    f"kage.bench run: config '{p[side]['name']}' ({p['pair']}, {side}) changed since {out} was "
+                    f"started (spec {old[side]['spec_sha256'][:12]} then, {p[side]['spec_sha256'][:12]} now): "
+                    "restore it, or run into another --out")
+
+
+def record_bench(out: str, manifest: str, seeds: List[int], trainer_args: List[str]) -> None:
+    """bench.json: the first run's manifest and trainer flags; later runs must use the same."""
+    path = os.path.join(out, "bench.json")
+    if os.path.exists(path):
+        with open(path) as f:
+            previous = json.load(f)
+        if previous["trainer_args"] != trainer_args:
+            raise SystemExit(f"kage.bench run: {out} was started with trainer flags {previous['trainer_args']}, now "
+                             f"{trainer_args}: use the same flags (results must share one protocol), or another --out")
+        seeds = sorted(set(previous["seeds"]) | set(seeds))
+    write_json(path, {"kage_bench": 1, "suite": manifest, "seeds": seeds, "trainer_args": trainer_args})
+
+
+def train_command(unit: Unit, seed: int, run_dir: str, trainer_args: List[str]) -> List[str]:
+    evals = ["--eval-config-path", unit.evals[0]] if len(unit.evals) == 1 else ["--eval-config-paths", *unit.evals]
+    return [sys.executable, "-m", "kage.train", "--train-config-path", unit.train, *evals,
+            "--eval-config-labels", *unit.labels, "--seed", str(seed), "--out", run_dir,
+            "--exp-name", unit.name.replace("/", "_"), *trainer_args]
+
+
+class Display:
+    """Runs done, the running run's steps/s and the ETA: one updating line on a terminal, one line per
+    finished run otherwise."""
+
+    def __init__(self, total: int, steps_per_run: int):
+        self.total, self.steps_per_run = total, steps_per_run
+        self.done = 0
+        self.live = sys.stderr.isatty()
+        self.rate: Optional[float] = None
+
+    def running(self, label: str, metrics_path: str) -> None:
+        step, rate = last_progress(metrics_path)
+        self.rate = rate or self.rate
+        remaining = (self.total - self.done) * self.steps_per_run - step
+        eta = f"ETA {remaining / self.rate / 60:,.0f} min" if self.rate else "ETA -"
+        speed = f"{self.rate:,.0f} steps/s" if self.rate else "- steps/s"
+        if self.live:
+            sys.stderr.write(f"\r\033[Kruns {self.done}/{self.total} · {label} step {step:,} · {speed} · {eta}")
+            sys.stderr.flush()
+
+    def finished(self, label: str, status: str) -> None:
+        self.done += 1
+        prefix = "\r\033[K" if self.live else ""
+        print(f"{prefix}[{self.done}/{self.total}] {label}: {status}", file=sys.stderr, flush=True)
+
+
+def last_progress(metrics_path: str):
+    """The global step and steps/s of a run's last training row (0, None before the first)."""
+    try:
+        with open(metrics_path, "rb") as f:
+            f.seek(max(0, os.path.getsize(metrics_path) - 65536))
+            lines = f.read().decode(errors="replace").splitlines()
+    except OSError:
+        return 0, None
+    for line in reversed(lines):
+        try:
+            row = json.loads(line)
+        except json.JSONDecodeError:
+            continue
+        if row.get("kind") == "train":
+            return row["global_step"], row["charts/SPS"]
+    return 0, None
+
+
+def main(argv: List[str]) -> int:
+    parser = argparse.ArgumentParser(prog="python3 -m kage.bench run", description=__doc__.split("\n\n")[0],
+                                     epilog="Any other flag is a trainer flag (python3 -m kage.train --help).")
+    parser.add_argument("suite", help="a suite manifest (suites/*.yaml)")
+    parser.add_argument("--seeds", default="1-10", help="seeds: 1-10 (default), 1,3,5 or 7")
+    parser.add_argument("--out", required=True, help="the benchmark directory (created, or continued)")
+    parser.add_argument("--pairs", nargs="+", help="only these pairs or sweeps (by name)")
+    args, trainer_args = parser.parse_known_args(argv)
+    for flag in ("--train-config-path", "--eval-config-path", "--eval-config-paths", "--eval-config-labels",
+                 "--seed", "--out", "--exp-name"):
+        if flag in trainer_args:
+            raise SystemExit(f"kage.bench run: {flag} is set per run by kage.bench; remove it")
+    from kage import train
+    probe = train.parse_args(["--train-config-path", args.suite, *trainer_args])  # trainer flags checked now
+    seeds = parse_seeds(args.seeds)
+    try:
+        report = json.loads(_kage.suite_report(args.suite))
+    except ConfigError as e:
+        raise SystemExit(f"{e}\nkage.bench run: fix the suite first") from None
+    units = units_of(report, args.pairs)
+    for p in report["pairs"]:
+        if not p["certified"] and any(p["pair"] == u.name or p["sweep"] == u.name for u in units):
+            print(f"kage.bench run: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
+
+    os.makedirs(args.out, exist_ok=True)
+    check_suite_unchanged(args.out, report)
+    record_bench(args.out, args.suite, seeds, trainer_args)
+    write_json(os.path.join(args.out, "suite.json"), report)
+
+    jobs = [(u, s) for u in units for s in seeds]
+    display = Display(len(jobs), probe.num_iterations * probe.batch_size)
+    failures = []
+    for unit, seed in jobs:
+        label = f"{unit.name} seed {seed}"
+        run_dir = os.path.join(args.out, "runs", unit.name, f"seed_{seed}")
+        if os.path.exists(os.path.join(run_dir, "summary.json")):
+            display.finished(label, "finished earlier, skipped")
+            continue
+        os.makedirs(run_dir, exist_ok=True)
+        with open(os.path.join(run_dir, "train.log"), "ab") as log:
+            child = subprocess.Popen(train_command(unit, seed, run_dir, trainer_args), stdout=log, stderr=log)
+            while child.poll() is None:
+                display.running(label, os.path.join(run_dir, "metrics.jsonl"))
+                time.sleep(1.0)
+        if child.returncode == 0:
+            display.finished(label, "done")
+        else:
+            failures.append(label)
+            display.finished(label, f"FAILED (exit {child.returncode}); see {run_dir}/train.log")
+    if failures:
+        print(f"kage.bench run: {len(failures)} run(s) failed: {', '.join(failures)}; rerun to resume them",
+              file=sys.stderr)
+        return 1
+    print(f"kage.bench run: {len(jobs)} runs in {args.out}; tables and plots: python3 -m kage.bench report {args.out}",
+          file=sys.stderr)
+    return 0

@@ -1,0 +1,250 @@
+"""A training run's directory: what it was trained on, its log, its checkpoint and its summary.
+
+    DIR/run.json                 arguments, code version, the configs' labels, paths and spec hashes
+    DIR/configs/<label>.json     every config's resolved Spec (kagec resolve); "train" is the train config
+    DIR/certificates/<label>.json  the train/eval pair's certificate (kagec diff --certify)
+    DIR/metrics.jsonl            one row per iteration ("kind": "train") and per evaluation ("kind": "eval")
+    DIR/checkpoints/latest.pt    parameters, optimizer, random streams, environments' state, loop state
+    DIR/summary.json             at the end: min, mean, median and max of every evaluated value (§3.4)
+
+Nothing is lost when the process is killed: files are replaced atomically (written beside, then
+renamed), log rows are flushed and synced one by one, and a rerun with the same arguments resumes from
+the checkpoint, dropping the log rows written after it, so the log has no gap and no duplicate. A
+finished run (summary.json) is never touched again; a config whose Spec changed since the run started is
+refused.
+"""
+import dataclasses
+import io
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import time
+from typing import Dict, List, Optional
+
+import torch
+
+from kage import _kage
+
+_RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
+
+
+def atomic_write(path: str, data: bytes) -> None:
+    """Replaces `path` with `data` so that a reader (or a crash) sees the old or the new file, never a part."""
+    tmp = f"{path}.tmp.{os.getpid()}"
+    with open(tmp, "wb") as f:
+        f.write(data)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def write_json(path: str, value) -> None:
+    atomic_write(path, (json.dumps(value, indent=1, sort_keys=True, allow_nan=False) + "\n").encode())
+
+
+def code_version() -> str:
+    """The git commit of the sources this package was built from, with "+dirty" for local changes."""
+    from kage import _build_info
+    try:
+        root = _build_info.source_root
+        commit = subprocess.run(["git", "-C", root, "rev-parse", "HEAD"], capture_output=True, text=True, check=True)
+        dirty = subprocess.run(["git", "-C", root, "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, check=True)
+        return commit.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown (no git checkout at the build's source root)"
+
+
+def json_args(args) -> dict:
+    """The arguments as JSON values (an infinite float as the string "inf" or "-inf")."""
+    return {k: (str(v) if isinstance(v, float) and not math.isfinite(v) else v) for k, v in dataclasses.asdict(args).items()}
+
+
+def default_dir(args) -> str:
+    stem = os.path.splitext(os.path.basename(args.train_config_path.rstrip("/")))[0]
+    return os.path.join("runs", f"{args.exp_name}__{stem}__{args.seed}")
+
+
+class RunDir:
+    def __init__(self, path: str, specs: Dict[str, dict]):
+        self.path = path
+        self.specs = specs
+        self._log = None
+
+    @property
+    def finished(self) -> bool:
+        return os.path.exists(os.path.join(self.path, "summary.json"))
+
+    @classmethod
+    def open(cls, args, labels: List[str]) -> "RunDir":
+        """The run directory of `args`: created with its description, or checked against it."""
+        from kage.train import eval_paths
+        path = args.out or default_dir(args)
+        configs = [("train", args.train_config_path)] + list(zip(labels, eval_paths(args)))
+        specs = {}
+        for label, config in configs:
+            if not os.path.exists(config):
+                raise SystemExit(f"kage.train: config '{config}' ({label}) not found")
+            specs[label] = json.loads(_kage.resolve(config, args.asset_root or ""))
+        described = {label: {"path": config, "spec_sha256": specs[label]["sha256"]} for label, config in configs}
+        run_json = os.path.join(path, "run.json")
+        if os.path.exists(run_json):
+            with open(run_json) as f:
+                previous = json.load(f)
+            check_same_run(path, previous, json_args(args), described)
+        else:
+            os.makedirs(os.path.join(path, "configs"), exist_ok=True)
+            os.makedirs(os.path.join(path, "certificates"), exist_ok=True)
+            os.makedirs(os.path.join(path, "checkpoints"), exist_ok=True)
+            for label, config in configs:
+                write_json(os.path.join(path, "configs", f"{safe(label)}.json"), specs[label])
+                if label != "train":
+                    certificate = json.loads(_kage.certify(args.train_config_path, config, args.asset_root or ""))
+                    write_json(os.path.join(path, "certificates", f"{safe(label)}.json"), certificate)
+            write_json(run_json, {
+                "kage_run": 1, "args": json_args(args), "argv": sys.argv, "configs": described,
+                "code_version": code_version(), "python": sys.version.split()[0], "torch": torch.__version__,
+                "device_name": torch.cuda.get_device_name() if args.device == "cuda" and torch.cuda.is_available()
+                else "cpu", "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+                "derived": {"batch_size": args.batch_size, "minibatch_size": args.minibatch_size,
+                            "num_iterations": args.num_iterations}})
+        return cls(path, specs)
+
+    # ---- the log ----
+
+    def log(self, row: dict) -> dict:
+        """Appends one row to metrics.jsonl, flushed and synced; returns it."""
+        if self._log is None:
+            self._log = open(os.path.join(self.path, "metrics.jsonl"), "a")
+        self._log.write(json.dumps(row, sort_keys=True, allow_nan=False) + "\n")
+        self._log.flush()
+        os.fsync(self._log.fileno())
+        return row
+
+    def _truncate_log(self, iteration: int) -> None:
+        """Keeps the rows of iterations up to `iteration` (written before its checkpoint) and drops the
+        rest, a partly written last line included."""
+        path = os.path.join(self.path, "metrics.jsonl")
+        if not os.path.exists(path):
+            return
+        kept = []
+        with open(path) as f:
+            for line in f:
+                try:
+                    row = json.loads(line)
+                except json.JSONDecodeError:
+                    break
+                if row["iteration"] <= iteration:
+                    kept.append(line if line.endswith("\n") else line + "\n")
+        atomic_write(path, "".join(kept).encode())
+
+    # ---- checkpoints ----
+
+    def save_checkpoint(self, state: dict) -> None:
+        buffer = io.BytesIO()
+        torch.save(state, buffer)
+        atomic_write(os.path.join(self.path, "checkpoints", "latest.pt"), buffer.getvalue())
+
+    def load_checkpoint(self, device) -> Optional[dict]:
+        """The latest checkpoint (and the log cut back to it), or None for a fresh run (the log emptied)."""
+        path = os.path.join(self.path, "checkpoints", "latest.pt")
+        if not os.path.exists(path):
+            self._truncate_log(-1)
+            return None
+        state = torch.load(path, map_location="cpu", weights_only=False)  # our own file
+        self._truncate_log(state["iteration"])
+        return state
+
+    # ---- the summary ----
+
+    def finish(self, history: List[dict]) -> None:
+        """summary.json: per evaluated value, its min, mean, median and max over all evaluation points,
+        iteration 0 and the final one included (§3.4); each statistic over the points that have a value."""
+        write_json(os.path.join(self.path, "summary.json"), summarize(history))
+        if self._log is not None:
+            self._log.close()
+
+
+def summarize(history: List[dict]) -> dict:
+    series: Dict[str, List[Optional[float]]] = {}
+    for point in history:
+        for key, value in flatten_evaluation(point).items():
+            series.setdefault(key, []).append(value)
+    return {"kage_summary": 1, "evaluations": len(history),
+            "iterations": [p["iteration"] for p in history], "global_steps": [p["global_step"] for p in history],
+            "stats": {key: statistics_of(values) for key, values in sorted(series.items())}}
+
+
+def flatten_evaluation(point: dict) -> Dict[str, Optional[float]]:
+    """An evaluation row as flat keys: train/<metric>, eval/<label>/<metric>, diff/<label>/<metric>."""
+    flat = {f"train/{m}": v for m, v in point["train"].items() if m != "episodes"}
+    for label, result in point["evals"].items():
+        flat.update({f"eval/{label}/{m}": v for m, v in result.items() if m != "episodes"})
+    for label, diff in point["diffs"].items():
+        flat.update({f"diff/{label}/{m}": v for m, v in diff.items()})
+    return flat
+
+
+def statistics_of(values: List[Optional[float]]) -> Optional[dict]:
+    present = [v for v in values if v is not None]
+    if not present:
+        return None
+    return {"min": min(present), "mean": statistics.fmean(present), "median": statistics.median(present),
+            "max": max(present), "n": len(present)}
+
+
+def check_same_run(path: str, previous: dict, args: dict, configs: dict) -> None:
+    """Refuses to resume `path` with other arguments or with configs whose Spec changed."""
+    for label, now in configs.items():
+        before = previous["configs"].get(label)
+        if before is None or before["path"] != now["path"]:
+            raise SystemExit(f"kage.train: {path} was started with other configs; use another --out")
+        if before["spec_sha256"] != now["spec_sha256"]:
+            raise SystemExit(
+                f"kage.train: config '{now['path']}' ({label}) changed since {path} started (spec "
+                f"{before['spec_sha256'][:12]} then, {now['spec_sha256'][:12]} now): restore it, or start a new run "
+                "with another --out")
+    changed = sorted(k for k in args if k not in _RESUMABLE_CHANGES and previous["args"].get(k) != args[k])
+    if changed:
+        details = ", ".join(f"{k}: {previous['args'].get(k)!r} then, {args[k]!r} now" for k in changed)
+        raise SystemExit(f"kage.train: {path} was started with other arguments ({details}); "
+                         "rerun with the original ones to resume, or use another --out")
+
+
+def safe(label: str) -> str:
+    return label.replace("/", "_").replace(" ", "_")
+
+
+class Progress:
+    """One line on stderr every 10 s and at each evaluation: iteration, steps, steps/s and the ETA."""
+
+    def __init__(self, iterations: int, batch: int):
+        self.iterations, self.batch = iterations, batch
+        self.start = time.time()
+        self.first_iteration = None
+        self.last_print = 0.0
+
+    def update(self, iteration: int, global_step: int, row: dict, evaluation: Optional[dict]) -> None:
+        if self.first_iteration is None:
+            self.first_iteration = iteration
+        now = time.time()
+        if evaluation is None and now - self.last_print < 10 and iteration != self.iterations:
+            return
+        self.last_print = now
+        done = iteration - self.first_iteration + 1
+        eta = (now - self.start) / done * (self.iterations - iteration)
+        line = (f"iteration {iteration}/{self.iterations}  step {global_step:,}  "
+                f"{row['charts/SPS']:,.0f} steps/s  ETA {eta / 60:.1f} min")
+        if evaluation is not None:
+            train = evaluation["train"]
+            line += f"  | eval return {fmt(train['return'])} success_once {train['success_once']:.2f}"
+            for label, result in evaluation["evals"].items():
+                line += f"  {label}: {fmt(result['return'])} / {result['success_once']:.2f}"
+        print(line, file=sys.stderr, flush=True)
+
+
+def fmt(value: Optional[float]) -> str:
+    return "-" if value is None else f"{value:.1f}"
