@@ -1,32 +1,10 @@
 #!/usr/bin/env bash
-# One device-machine call for the Python package: build kagec and the package against the device's
-# python3 (its pip pybind11, torch, JAX, CuPy) with the Debian libraries carried in .deps, then run the
-# GPU tests (tests/gpu) and the Python step loop beside `kagec bench --gpu`, logging under $OUT.
-# Make .deps here first (bench/make_deps.sh), then: run with carry [".deps"] and
+# One device-machine call for the Python package: build (bench/device_build.sh), then the GPU tests
+# (tests/gpu) and the Python step loop beside `kagec bench --gpu`, logging under $OUT.
+# Make .deps here first (bench/make_deps.sh), then run with carry [".deps"]:
 #   bash bench/python_device.sh [CONFIG ...]
 set -uo pipefail
-OUT=${OUT:-/tmp/kage-python-out}
-BUILD=${BUILD:-build-dev}
-mkdir -p "$OUT"
-DEPS=$PWD/.deps/usr
-export CPATH=$DEPS/include
-export LD_LIBRARY_PATH=$DEPS/lib/x86_64-linux-gnu:/usr/local/cuda/lib64:${LD_LIBRARY_PATH:-}
-export KAGE_CACHE_DIR=/tmp/kage-cache PYTHONUNBUFFERED=1
-nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,clocks.mem --format=csv | tee "$OUT/gpu.txt"
-python3 -c 'import sys, torch, pybind11; print(sys.version.split()[0], torch.__version__, pybind11.__version__)' | tee -a "$OUT/gpu.txt"
-
-# The interpreter's headers, or the carried 3.12 headers when its distribution left them out.
-python_include=()
-if ! python3 -c 'import os, sysconfig, sys; sys.exit(not os.path.exists(sysconfig.get_paths()["include"] + "/Python.h"))'; then
-  python_include=(-DPython_INCLUDE_DIR="$PWD/.deps/python3.12/include/python3.12")
-fi
-# Incremental: a warm machine keeps the build directory between calls.
-cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release -DKAGE_BUILD_TESTS=OFF \
-  -DPython_EXECUTABLE="$(command -v python3)" "${python_include[@]}" -DCMAKE_PREFIX_PATH="$DEPS" \
-  >"$OUT/build.log" 2>&1 && ninja -C "$BUILD" kagec kage_python >>"$OUT/build.log" 2>&1 ||
-  { tail -40 "$OUT/build.log"; exit 1; }
-export PYTHONPATH=$PWD/$BUILD/python
-
+source bench/device_build.sh
 python3 -m pytest -q -p no:cacheprovider tests/gpu 2>&1 | tee "$OUT/gpu_tests.log"
 configs=("$@")
 [ ${#configs[@]} -eq 0 ] && configs=(configs/throughput/simplest.yaml configs/kage_bench/filters/3-eval.yaml)

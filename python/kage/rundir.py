@@ -27,22 +27,9 @@ from typing import Dict, List, Optional
 import torch
 
 from kage import _kage
+from kage.files import atomic_write, safe, write_json
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
-
-
-def atomic_write(path: str, data: bytes) -> None:
-    """Replaces `path` with `data` so that a reader (or a crash) sees the old or the new file, never a part."""
-    tmp = f"{path}.tmp.{os.getpid()}"
-    with open(tmp, "wb") as f:
-        f.write(data)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-
-
-def write_json(path: str, value) -> None:
-    atomic_write(path, (json.dumps(value, indent=1, sort_keys=True, allow_nan=False) + "\n").encode())
 
 
 def code_version() -> str:
@@ -212,10 +199,6 @@ def check_same_run(path: str, previous: dict, args: dict, configs: dict) -> None
         details = ", ".join(f"{k}: {previous['args'].get(k)!r} then, {args[k]!r} now" for k in changed)
         raise SystemExit(f"kage.train: {path} was started with other arguments ({details}); "
                          "rerun with the original ones to resume, or use another --out")
-
-
-def safe(label: str) -> str:
-    return label.replace("/", "_").replace(" ", "_")
 
 
 class Progress:

@@ -19,7 +19,6 @@ the log. A run directory holds everything needed to resume a killed run exactly 
 """
 import argparse
 import dataclasses
-import json
 import math
 import os
 import random
@@ -34,6 +33,7 @@ import torch.nn as nn
 
 import kage
 from kage import rundir
+from kage.wrappers import FrameStack, RewardNormalizer
 
 METRICS = ("x", "y", "vx_mean", "vy_mean", "passed_distance", "progress", "jump_count", "success", "success_once")
 DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # §3.3
@@ -257,52 +257,6 @@ def entropy_coefficient(args: Args, optimizer_steps: int) -> float:
     return args.ent_coef * min(max(1.0 - optimizer_steps / total, 0.0), 1.0)
 
 
-# ---- observation and reward wrappers (§1.1, §2.2) ----
-
-class FrameStack:
-    """The last 4 frames on the channel axis, oldest first; refilled with the new frame at reset and
-    wherever an episode ended (§1.1)."""
-
-    def __init__(self, frame: torch.Tensor, frames: int = 4):
-        self.frames = frames
-        self.stack = frame.repeat(1, 1, 1, frames).contiguous()
-
-    def push(self, frame: torch.Tensor, done: torch.Tensor) -> torch.Tensor:
-        c = frame.shape[-1]
-        self.stack = torch.cat([self.stack[..., c:], frame], dim=-1)
-        refill = frame.repeat(1, 1, 1, self.frames)
-        self.stack = torch.where(done.bool()[:, None, None, None], refill, self.stack)
-        return self.stack
-
-
-class RewardNormalizer:
-    """Per-environment running return statistics, as RewardNormalizeWrapper(gamma=0.999) (§2.2, kage-env
-    10.4): ret = ret * gamma * (1 - done) + r, Welford-style mean/var, emits r / (sqrt(var) + 1e-8)."""
-
-    def __init__(self, num_envs: int, gamma: float, device):
-        self.gamma = gamma
-        self.ret = torch.zeros(num_envs, device=device)
-        self.mean = torch.zeros(num_envs, device=device)
-        self.var = torch.ones(num_envs, device=device)
-        self.count = torch.full((num_envs,), 1e-4, device=device)
-
-    def __call__(self, reward: torch.Tensor, done: torch.Tensor) -> torch.Tensor:
-        self.ret = self.ret * self.gamma * (1 - done) + reward
-        delta = self.ret - self.mean
-        count = self.count + 1
-        mean = self.mean + delta / count
-        self.var = (self.var * self.count + delta * (self.ret - mean)) / count
-        self.mean, self.count = mean, count
-        return reward / (torch.sqrt(self.var) + 1e-8)
-
-    def state_dict(self) -> dict:
-        return {k: getattr(self, k) for k in ("ret", "mean", "var", "count")}
-
-    def load_state_dict(self, state: dict) -> None:
-        for k, v in state.items():
-            setattr(self, k, v)
-
-
 # ---- episode metrics (§4) ----
 
 class EpisodeMetrics:
@@ -325,36 +279,39 @@ class EpisodeMetrics:
 
 
 @torch.no_grad()
-def evaluate(agent: Agent, env: "kage.VecEnv", eval_seed: int, episodes: int, episode_length: int,
-             dist_to_success: float, greedy: bool, frame_stack: bool) -> Dict[str, Optional[float]]:
-    """One config's evaluation (§3.2) in fresh environments: sampled actions until `episodes` episodes
-    have finished. Steps are queued without a host synchronisation: every KAGE episode ends by truncation
-    at `episode_length` (§2.3), so ceil(episodes / envs) waves of episode_length steps finish them; the
-    host checks the count once, after the waves (and steps on, a wave at a time, if it fell short)."""
+def evaluate(agent: Agent, envs: List["kage.VecEnv"], seeds: List[int], dists_to_success: List[float], episodes: int,
+             episode_length: int, greedy: bool, frame_stack: bool) -> List[Dict[str, Optional[float]]]:
+    """The evaluations of several configs (§3.2), each in fresh environments with its own seed and
+    sampling stream, stepped together: one forward pass per step for all their environments. Sampled
+    actions until `episodes` episodes have finished in each. Steps are queued without a host
+    synchronisation: every KAGE episode ends by truncation at `episode_length` (§2.3), so
+    ceil(episodes / envs) waves of episode_length steps finish them; the host checks the counts once,
+    after the waves (and steps on, a wave at a time, if one fell short)."""
     device = next(agent.parameters()).device
-    n = env.num_envs
-    generator = torch.Generator(device=device).manual_seed(eval_seed)
-    obs, info = env.reset(seed=eval_seed)
-    frames = torch.from_dlpack(obs)
-    stack = FrameStack(frames) if frame_stack else None
-    metrics = EpisodeMetrics(env, info, dist_to_success)
-    chunk = -(-episodes // n) * episode_length
-    records = []
+    generators = [torch.Generator(device=device).manual_seed(seed) for seed in seeds]
+    frames, stacks, metrics = [], [], []
+    for env, seed, dist in zip(envs, seeds, dists_to_success):
+        obs, info = env.reset(seed=seed)
+        frames.append(torch.from_dlpack(obs))
+        stacks.append(FrameStack(frames[-1]) if frame_stack else None)
+        metrics.append(EpisodeMetrics(env, info, dist))
+    chunk = -(-episodes // min(env.num_envs for env in envs)) * episode_length
+    records: List[List[torch.Tensor]] = [[] for _ in envs]
     while True:
         for _ in range(chunk):
-            x = stack.stack if stack else frames
-            logits = agent.actor(agent.features(x))
-            if greedy:
-                action = logits.argmax(1)
-            else:
-                action = torch.multinomial(torch.softmax(logits, 1), 1, generator=generator).squeeze(1)
-            env.step(action)
-            if stack:
-                stack.push(frames, metrics.mask)
-            records.append(metrics.rows())
-        if int(torch.stack(records)[:, 0].sum()) >= episodes:
+            x = torch.cat([s.stack if s else f for f, s in zip(frames, stacks)])
+            logits = agent.actor(agent.features(x)).split([env.num_envs for env in envs])
+            for env, logit, generator, frame, stack, metric, record in zip(envs, logits, generators, frames, stacks,
+                                                                           metrics, records):
+                # QUIRK: sampled, not greedy. Gumbel-max is an exact categorical sampler with no host check.
+                env.step(logit.argmax(1) if greedy else sample_gumbel_max(logit, generator)[0])
+                if stack:
+                    stack.push(frame, metric.mask)
+                record.append(metric.rows())
+        counts = torch.stack([torch.stack(r)[:, 0].sum() for r in records]).tolist()
+        if min(counts) >= episodes:
             break
-    return summarize_evaluation(torch.stack(records).cpu(), episodes)
+    return [summarize_evaluation(torch.stack(r).cpu(), episodes) for r in records]
 
 
 def summarize_evaluation(records: torch.Tensor, episodes: int) -> Dict[str, Optional[float]]:
@@ -382,18 +339,20 @@ def summarize_evaluation(records: torch.Tensor, episodes: int) -> Dict[str, Opti
 
 
 def evaluation_point(agent, eval_envs, args: Args, iteration: int, global_step: int, specs) -> dict:
-    """Evaluates the current parameters on the train config, then on each eval config (§3.2), and the
-    absolute differences train - eval (§3.3)."""
+    """Evaluates the current parameters on the train config and on each eval config (§3.2; seed offsets
+    20,000 for the train config, 10,000 + 1,000 i for the i-th eval config), and the absolute
+    differences train - eval (§3.3)."""
     start = time.perf_counter()
     was_training = agent.training
     agent.eval()
-    results = {}
-    for i, (label, env) in enumerate(eval_envs.items()):
-        offset = TRAIN_OFFSET if i == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * (i - 1)
-        spec = specs[label]["config"]
-        results[label] = evaluate(agent, env, args.seed + offset + iteration, args.eval_episodes,
-                                  spec["episode_length"], spec["dist_to_success"], args.eval_greedy,
-                                  args.use_frame_stack)
+    labels = list(eval_envs)
+    seeds = [args.seed + (TRAIN_OFFSET if i == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * (i - 1)) + iteration
+             for i in range(len(labels))]
+    configs = [specs[label]["config"] for label in labels]
+    results = dict(zip(labels, evaluate(agent, list(eval_envs.values()), seeds,
+                                        [c["dist_to_success"] for c in configs], args.eval_episodes,
+                                        max(c["episode_length"] for c in configs), args.eval_greedy,
+                                        args.use_frame_stack)))
     agent.train(was_training)
     train_label, *labels = list(eval_envs)
     diffs = {label: {m: absolute_difference(results[train_label][m], results[label][m]) for m in DIFF_METRICS}
@@ -563,11 +522,11 @@ def main(argv: Optional[List[str]] = None) -> int:
         var_returns = b_returns.var(unbiased=False)
         explained_var = 1 - (b_returns - b_values).var(unbiased=False) / (var_returns + 1e-8)
         stored = last_return != 0
-        scalars = torch.stack([v_loss, pg_loss, entropy, approx_kl, clipfrac, loss, explained_var, var_returns,
-                               torch.where(stored, last_return, 0).sum() / stored.sum().clamp(min=1),
-                               torch.where(stored, last_length, 0).sum() / stored.sum().clamp(min=1),
-                               any_finished.float()]).tolist()
-        sums = episode_sums.tolist()
+        scalars = torch.cat([torch.stack([v_loss, pg_loss, entropy, approx_kl, clipfrac, loss, explained_var,
+                                          var_returns, torch.where(stored, last_return, 0).sum() / stored.sum().clamp(min=1),
+                                          torch.where(stored, last_length, 0).sum() / stored.sum().clamp(min=1),
+                                          any_finished.float()]), episode_sums]).tolist()
+        sums = scalars[11:]
         iteration_seconds = time.perf_counter() - iteration_start
         train_seconds += iteration_seconds
         row = {"kind": "train", "iteration": iteration, "global_step": global_step,

@@ -26,7 +26,7 @@ from typing import Dict, List, Optional
 
 from kage import _kage
 from kage.errors import ConfigError
-from kage.rundir import write_json
+from kage.files import write_json
 
 
 @dataclasses.dataclass
@@ -102,8 +102,9 @@ def check_suite_unchanged(out: str, report: dict) -> None:
                     "restore it, or run into another --out")
 
 
-def record_bench(out: str, manifest: str, seeds: List[int], trainer_args: List[str]) -> None:
-    """bench.json: the first run's manifest and trainer flags; later runs must use the same."""
+def record_bench(out: str, manifest: str, seeds: List[int], units: List[str], trainer_args: List[str]) -> None:
+    """bench.json: the manifest, the trainer flags of the first run (later runs must use the same), and the
+    seeds and units (pairs, sweeps) asked for so far, which the report covers."""
     path = os.path.join(out, "bench.json")
     if os.path.exists(path):
         with open(path) as f:
@@ -112,7 +113,8 @@ def record_bench(out: str, manifest: str, seeds: List[int], trainer_args: List[s
             raise SystemExit(f"kage.bench run: {out} was started with trainer flags {previous['trainer_args']}, now "
                              f"{trainer_args}: use the same flags (results must share one protocol), or another --out")
         seeds = sorted(set(previous["seeds"]) | set(seeds))
-    write_json(path, {"kage_bench": 1, "suite": manifest, "seeds": seeds, "trainer_args": trainer_args})
+        units = previous["units"] + [u for u in units if u not in previous["units"]]
+    write_json(path, {"kage_bench": 1, "suite": manifest, "seeds": seeds, "units": units, "trainer_args": trainer_args})
 
 
 def train_command(unit: Unit, seed: int, run_dir: str, trainer_args: List[str]) -> List[str]:
@@ -192,7 +194,7 @@ def main(argv: List[str]) -> int:
 
     os.makedirs(args.out, exist_ok=True)
     check_suite_unchanged(args.out, report)
-    record_bench(args.out, args.suite, seeds, trainer_args)
+    record_bench(args.out, args.suite, seeds, [u.name for u in units], trainer_args)
     write_json(os.path.join(args.out, "suite.json"), report)
 
     jobs = [(u, s) for u in units for s in seeds]

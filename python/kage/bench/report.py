@@ -1,0 +1,424 @@
+"""python3 -m kage.bench report DIR: the benchmark's tables and plots from a directory of training runs.
+
+Input, as `python3 -m kage.bench run` writes it:
+
+    DIR/suite.json                 the suite's pairs (kagec suite): names, axes, sweeps, certificates
+    DIR/bench.json                 the seeds asked for (optional here)
+    DIR/runs/<unit>/seed_<s>/      a kage.train run directory: a plain pair's (unit = the pair's name, eval
+                                   label "eval") or a sweep's (unit = the sweep's name, one eval label per
+                                   eval config: its name in the sweep)
+
+The protocol is the paper's (kage-ppo-baseline.md §5), in three levels:
+1. per run: each value's maximum over the run's evaluation points (summary.json's "max"), the train side
+   (train/<m>), each eval side (eval/<label>/<m>) and each absolute difference (diff/<label>/<m>) maximised
+   independently, so a run's best train and best eval values may come from different checkpoints (§5.1);
+2. per pair: the mean and SEM over seeds, SEM = s / sqrt(n) with s the sample standard deviation
+   (divisor n - 1), and SEM = 0 for n = 1 (§5.2);
+3. per axis: the mean and SEM (same formula) of the axis's per-pair means, each pair weighted equally, the
+   seed-level SEMs discarded (§5.3). Only plain pairs enter the axes; a sweep gets its own table, one row
+   per eval config, at level 2.
+At every level, gap = train - eval and drop = 100 * (train - eval) / train are computed on the aggregated
+means of that level, not averaged from the level below. The paper's per-axis drops match this formula; the
+original code does not compute it (§5.4). The drop is undefined (null in JSON, empty in CSV, "n/a" in
+Markdown) where the train mean is 0. `max_abs_diff` is the original's own gap measure: per run, the largest
+|train - eval| at a single evaluation point, then averaged like any other value.
+
+Only finished runs (with summary.json) enter the tables; unfinished ones are counted and listed. A pair,
+sweep or axis without a finished run appears with n = 0 and empty values. A side's mean is over the values
+that exist: return and length are null where every listed episode returned exactly 0; report.json gives
+each side's n.
+
+The Markdown tables show `success_once` in their "success" column (the episode reached the goal at some
+step: what the paper's success-rate plots show); `success` (past the goal at the episode's end) is in the
+CSV and JSON files with every other metric.
+
+Output, in DIR/report/ (or out_dir), each file replaced atomically:
+
+    axes.md, axes.csv        level 3 (if the suite has plain pairs): the headline table
+    pairs.md, pairs.csv      level 2, plain pairs (if any)
+    sweeps.md, sweeps.csv    level 2, per sweep and eval config (if the suite has sweeps)
+    runs.csv                 level 1, one row per run, eval config and metric
+    report.md                all the Markdown tables, the axes first
+    report.json              everything above, the runs found and the protocol
+    plots/*.png              see kage.bench.plots
+"""
+import json
+import math
+import os
+import re
+import statistics
+import sys
+from dataclasses import dataclass
+from typing import Dict, List, NoReturn, Optional, Sequence, Tuple
+
+from kage.bench import plots
+from kage.bench.tables import METRICS, SUCCESS_SHOWN, write_tables
+from kage.files import atomic_write, safe
+
+DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # as kage.train logs
+PLAIN_LABEL = "eval"  # the eval label of a plain pair's runs (kage.bench run)
+
+
+def fail(message: str) -> NoReturn:
+    raise SystemExit(f"kage.bench report: {message}")
+
+
+# ---- reading the benchmark directory ----
+
+@dataclass
+class Unit:
+    """What one run per seed trains: a plain pair, or a whole sweep (its eval configs in manifest order)."""
+
+    name: str
+    is_sweep: bool
+    pairs: List[dict]  # the suite.json entries
+
+
+@dataclass
+class Run:
+    seed: int
+    path: str
+    stats: Optional[dict]  # summary.json's stats; None while the run is unfinished
+    evaluations: List[dict]  # the evaluation rows of metrics.jsonl
+
+
+def read_json(path: str, remedy: str):
+    try:
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except FileNotFoundError:
+        fail(f"{path} not found: {remedy}")
+    except (OSError, ValueError) as e:
+        fail(f"{path} is not readable JSON ({e}): {remedy}")
+
+
+def load_suite(bench_dir: str) -> dict:
+    if not os.path.isdir(bench_dir):
+        fail(f"{bench_dir} is not a directory: give the --out directory of `python3 -m kage.bench run`")
+    path = os.path.join(bench_dir, "suite.json")
+    if not os.path.exists(path):
+        fail(f"{path} not found: is {bench_dir} a directory written by `python3 -m kage.bench run`?")
+    rerun = "delete it and rerun `python3 -m kage.bench run` with the same suite and --out to write it again " \
+            "(finished runs are kept)"
+    suite = read_json(path, rerun)
+    pair_keys = ("pair", "declared_axis", "sweep", "sweep_eval", "train", "eval")
+    if not (isinstance(suite, dict) and suite.get("kagec_suite_report") == 1 and isinstance(suite.get("pairs"), list)
+            and all(isinstance(p, dict) and all(k in p for k in pair_keys) and isinstance(p["train"], dict)
+                    for p in suite["pairs"])):
+        fail(f"{path} is not a suite report of kagec (\"kagec_suite_report\": 1 with pairs {', '.join(pair_keys)}): "
+             f"{rerun}")
+    return suite
+
+
+def read_bench(bench_dir: str) -> dict:
+    """bench.json, informational: {} where it is absent."""
+    path = os.path.join(bench_dir, "bench.json")
+    if not os.path.exists(path):
+        return {}
+    bench = read_json(path, "fix or delete it (the report reads only its seeds and units)")
+    return bench if isinstance(bench, dict) else {}
+
+
+def units_of(suite: dict, selected: Optional[List[str]] = None) -> List[Unit]:
+    """The suite's plain pairs and sweeps in manifest order, as kage.bench run trains them; only the
+    `selected` ones (bench.json's "units": what `run --pairs` chose) when given."""
+    units: Dict[str, Unit] = {}
+    for pair in suite["pairs"]:
+        if pair["sweep"] is None:
+            units[pair["pair"]] = Unit(pair["pair"], False, [pair])
+        else:
+            units.setdefault(pair["sweep"], Unit(pair["sweep"], True, [])).pairs.append(pair)
+    return [u for u in units.values() if selected is None or u.name in selected]
+
+
+def label_of(pair: dict) -> str:
+    return PLAIN_LABEL if pair["sweep"] is None else pair["sweep_eval"]
+
+
+def find_runs(bench_dir: str, unit: Unit) -> List[Run]:
+    """The unit's run directories (runs/<unit>/seed_<s>/), by seed."""
+    unit_dir = os.path.join(bench_dir, "runs", unit.name)
+    if not os.path.isdir(unit_dir):
+        return []
+    runs = []
+    for entry in os.listdir(unit_dir):
+        match = re.fullmatch(r"seed_(\d+)", entry)
+        path = os.path.join(unit_dir, entry)
+        if match and os.path.isdir(path):
+            runs.append(read_run(int(match[1]), path))
+    return sorted(runs, key=lambda r: r.seed)
+
+
+def read_run(seed: int, path: str) -> Run:
+    summary = os.path.join(path, "summary.json")
+    metrics = os.path.join(path, "metrics.jsonl")
+    stats = read_summary(summary) if os.path.exists(summary) else None
+    evaluations = read_evaluations(metrics) if os.path.exists(metrics) else []
+    return Run(seed, path, stats, evaluations)
+
+
+def is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def read_summary(path: str) -> dict:
+    """summary.json's stats: {key: {"max": ..., ...} or null}."""
+    remedy = "delete it and rerun `python3 -m kage.bench run` on the directory to write it again from the run's " \
+             "last checkpoint"
+    summary = read_json(path, remedy)
+    stats = summary.get("stats") if isinstance(summary, dict) else None
+    if not (isinstance(summary, dict) and summary.get("kage_summary") == 1 and isinstance(stats, dict)
+            and all(v is None or (isinstance(v, dict) and is_number(v.get("max"))) for v in stats.values())):
+        fail(f"{path} is not a kage.train summary ({{\"kage_summary\": 1, \"stats\": {{key: {{\"max\": number, ...}} "
+             f"or null}}}}): {remedy}")
+    return stats
+
+
+def read_evaluations(path: str) -> List[dict]:
+    """The evaluation rows of a metrics.jsonl. A last line that does not parse is a row the run was
+    killed while writing, and is skipped; a damaged line before it is an error."""
+    try:
+        with open(path, "rb") as f:
+            lines = f.read().decode("utf-8", errors="replace").splitlines()
+    except OSError as e:
+        fail(f"cannot read {path} ({e}): make it readable, or delete the run directory and rerun it")
+    rows = []
+    for number, line in enumerate(lines, start=1):
+        if not line.strip():
+            continue
+        try:
+            row = json.loads(line)
+        except ValueError:
+            if number == len(lines):
+                break
+            fail(f"{path}, line {number}: not a JSON row, the log is damaged: delete that line, or delete the run "
+                 "directory and rerun `python3 -m kage.bench run` to train the run again")
+        if not isinstance(row, dict) or "kind" not in row:
+            fail(f"{path}, line {number}: not a kage.train log row (no \"kind\"): delete that line, or delete the run "
+                 "directory and rerun `python3 -m kage.bench run` to train the run again")
+        if row["kind"] == "eval":
+            if not (is_number(row.get("global_step")) and isinstance(row.get("train"), dict)
+                    and isinstance(row.get("evals"), dict)):
+                fail(f"{path}, line {number}: an evaluation row without global_step, train and evals: delete that "
+                     "line, or delete the run directory and rerun `python3 -m kage.bench run`")
+            rows.append(row)
+    return rows
+
+
+# ---- the three levels (§5.1-5.3) ----
+
+def mean_sem(values: Sequence[Optional[float]]) -> dict:
+    """{"mean", "sem", "n"} of the values that exist: SEM = sample standard deviation / sqrt(n), 0 for n = 1."""
+    present = [v for v in values if v is not None]
+    n = len(present)
+    if n == 0:
+        return {"mean": None, "sem": None, "n": 0}
+    sem = statistics.stdev(present) / math.sqrt(n) if n > 1 else 0.0
+    return {"mean": statistics.fmean(present), "sem": sem, "n": n}
+
+
+def gap_and_drop(train: Optional[float], evaluated: Optional[float]) -> Tuple[Optional[float], Optional[float]]:
+    """train - eval, and the drop 100 * (train - eval) / train in percent (None where train is 0)."""
+    if train is None or evaluated is None:
+        return None, None
+    gap = train - evaluated
+    return gap, (100.0 * gap / train if train != 0 else None)
+
+
+def stat_max(stats: dict, key: str, where: str) -> Optional[float]:
+    if key not in stats:
+        fail(f"{where} has no '{key}': the run was not evaluated on this suite's configs (evaluation off, or other "
+             "eval labels); delete the run directory and rerun `python3 -m kage.bench run`")
+    return None if stats[key] is None else float(stats[key]["max"])
+
+
+def run_maxima(stats: dict, label: str, where: str = "summary.json") -> Dict[str, dict]:
+    """Level 1: per metric, the run's maxima over training of the train side, of the eval side `label` and
+    of their absolute difference, each on its own; and the gap and drop of the two maxima."""
+    values = {}
+    for m in METRICS:
+        train = stat_max(stats, f"train/{m}", where)
+        evaluated = stat_max(stats, f"eval/{label}/{m}", where)
+        gap, drop = gap_and_drop(train, evaluated)
+        diff = stat_max(stats, f"diff/{label}/{m}", where) if m in DIFF_METRICS else None
+        values[m] = {"train": train, "eval": evaluated, "gap": gap, "drop_pct": drop, "max_abs_diff": diff}
+    return values
+
+
+def combine(samples: List[Dict[str, dict]]) -> Dict[str, dict]:
+    """Per metric, the mean and SEM of each side over `samples` ({metric: {"train", "eval", "max_abs_diff"}}
+    numbers), and the gap and drop of the two means."""
+    combined = {}
+    for m in METRICS:
+        train = mean_sem([s[m]["train"] for s in samples])
+        evaluated = mean_sem([s[m]["eval"] for s in samples])
+        gap, drop = gap_and_drop(train["mean"], evaluated["mean"])
+        diff = mean_sem([s[m]["max_abs_diff"] for s in samples]) if m in DIFF_METRICS else None
+        combined[m] = {"train": train, "eval": evaluated, "gap": gap, "drop_pct": drop, "max_abs_diff": diff}
+    return combined
+
+
+def over_seeds(run_values: List[Dict[str, dict]]) -> Dict[str, dict]:
+    """Level 2: a pair's runs' maxima (run_maxima), over seeds."""
+    return combine(run_values)
+
+
+def over_pairs(pair_values: List[Dict[str, dict]]) -> Dict[str, dict]:
+    """Level 3: the per-pair means of an axis's pairs (over_seeds), each pair weighted equally."""
+    means = [{m: {side: (v[m][side]["mean"] if v[m][side] else None) for side in ("train", "eval", "max_abs_diff")}
+              for m in METRICS} for v in pair_values]
+    return combine(means)
+
+
+def sweep_order(names: List[str]) -> List[str]:
+    """A sweep's eval names by value where all are numbers, else in manifest order."""
+    try:
+        return sorted(names, key=float)
+    except ValueError:
+        return list(names)
+
+
+def aggregate(units: List[Unit], runs: Dict[str, List[Run]]) -> dict:
+    """The three levels: {"runs": level 1, "pairs": level 2 (plain pairs), "axes": level 3, "sweeps": level 2
+    per sweep}."""
+    level1, pairs, sweeps = [], [], []
+    for unit in units:
+        finished = [r for r in runs[unit.name] if r.stats is not None]
+        results = {}
+        for pair in unit.pairs:
+            label = label_of(pair)
+            per_run = []
+            for run in finished:
+                values = run_maxima(run.stats, label, os.path.join(run.path, "summary.json"))
+                level1.append({"pair": pair["pair"], "unit": unit.name, "seed": run.seed, "label": label,
+                               "path": run.path, "metrics": values})
+                per_run.append(values)
+            results[pair["pair"]] = {
+                "pair": pair["pair"], "axis": pair["declared_axis"], "certified": pair.get("certified"),
+                "n_seeds": len(finished), "seeds": [r.seed for r in finished], "metrics": over_seeds(per_run)}
+        if not unit.is_sweep:
+            pairs.append(results[unit.name])
+            continue
+        by_name = {p["sweep_eval"]: results[p["pair"]] for p in unit.pairs}
+        evals = [dict(by_name[name], sweep_eval=name) for name in sweep_order(list(by_name))]
+        sweeps.append({"sweep": unit.name, "axis": unit.pairs[0]["declared_axis"],
+                       "train_config": unit.pairs[0]["train"].get("name"), "n_seeds": len(finished),
+                       "seeds": [r.seed for r in finished], "evals": evals})
+    return {"runs": level1, "pairs": pairs, "axes": axes_of(pairs), "sweeps": sweeps}
+
+
+def axes_of(pairs: List[dict]) -> List[dict]:
+    """Level 3 per axis, axes in the order of their first pair."""
+    names: List[str] = []
+    for p in pairs:
+        if p["axis"] not in names:
+            names.append(p["axis"])
+    axes = []
+    for name in names:
+        members = [p for p in pairs if p["axis"] == name]
+        axes.append({"axis": name, "n_pairs": sum(1 for p in members if p["n_seeds"] > 0),
+                     "pairs": [p["pair"] for p in members], "metrics": over_pairs([p["metrics"] for p in members])})
+    return axes
+
+
+def run_status(units: List[Unit], runs: Dict[str, List[Run]], seeds: List[int]) -> dict:
+    """Finished runs, unfinished ones (not in the tables) and seeds of bench.json without a run directory."""
+    finished, unfinished, not_started = 0, [], []
+    for unit in units:
+        found = {r.seed for r in runs[unit.name]}
+        for run in runs[unit.name]:
+            if run.stats is not None:
+                finished += 1
+            else:
+                unfinished.append({"unit": unit.name, "seed": run.seed, "path": run.path})
+        not_started += [{"unit": unit.name, "seed": s} for s in seeds if s not in found]
+    return {"finished": finished, "unfinished": unfinished, "not_started": not_started}
+
+
+# ---- plots ----
+
+def curve(evaluations: List[List[dict]], label: Optional[str], metric: str) -> List[Tuple[float, dict]]:
+    """Per evaluation step, the mean and SEM over the runs evaluated at that step of `metric` on the train
+    config (label None) or on eval config `label`; `evaluations` holds each run's evaluation rows."""
+    by_step: Dict[float, List[Optional[float]]] = {}
+    for rows in evaluations:
+        for row in rows:
+            side = row["train"] if label is None else row["evals"].get(label)
+            value = side.get(metric) if isinstance(side, dict) else None
+            by_step.setdefault(row["global_step"], []).append(value if is_number(value) else None)
+    return [(step, mean_sem(values)) for step, values in sorted(by_step.items())]
+
+
+def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], levels: dict) -> List[str]:
+    """The PNG files under plots/ (see kage.bench.plots); returns their names relative to out_dir."""
+    figures: Dict[str, bytes] = {}
+    for unit in units:
+        evaluations = [r.evaluations for r in runs[unit.name] if r.evaluations]
+        if unit.is_sweep or not evaluations:
+            continue
+        unfinished = sum(1 for r in runs[unit.name] if r.evaluations and r.stats is None)
+        title = unit.name + (f" ({len(evaluations)} runs, {unfinished} unfinished)" if unfinished else "")
+        for metric, suffix, ylabel, ylim in ((SUCCESS_SHOWN, "", "success rate (success_once)", (0, 1.1)),
+                                             ("return", "_return", "return", None)):
+            figures[f"plots/curves_{safe(unit.name)}{suffix}.png"] = plots.training_curves(
+                title, curve(evaluations, None, metric), curve(evaluations, PLAIN_LABEL, metric), ylabel, ylim)
+    if levels["axes"]:
+        drops = [a["metrics"][SUCCESS_SHOWN]["drop_pct"] for a in levels["axes"]]
+        figures["plots/drop_per_axis.png"] = plots.drop_per_axis([a["axis"] for a in levels["axes"]], drops)
+    for s in levels["sweeps"]:
+        figures[f"plots/sweep_{safe(s['sweep'])}.png"] = plots.sweep_response(
+            f"{s['sweep']} ({s['axis']})", [e["sweep_eval"] for e in s["evals"]],
+            [e["metrics"][SUCCESS_SHOWN]["eval"] for e in s["evals"]], s["evals"][0]["metrics"][SUCCESS_SHOWN]["train"])
+    os.makedirs(os.path.join(out_dir, "plots"), exist_ok=True)
+    for name, png in figures.items():
+        atomic_write(os.path.join(out_dir, name), png)
+    return sorted(figures)
+
+
+# ---- the command ----
+
+def report(bench_dir: str, out_dir: Optional[str] = None) -> dict:
+    """Reads the benchmark directory `bench_dir`, writes the tables, plots and report.json into `out_dir`
+    (default bench_dir/report) and returns report.json's content."""
+    suite = load_suite(bench_dir)
+    bench = read_bench(bench_dir)
+    out_dir = out_dir or os.path.join(bench_dir, "report")
+    units = units_of(suite, bench.get("units"))
+    runs = {unit.name: find_runs(bench_dir, unit) for unit in units}
+    levels = aggregate(units, runs)
+    status = run_status(units, runs, [s for s in bench.get("seeds", []) if isinstance(s, int)])
+    result = {
+        "kage_bench_report": 1, "suite": suite.get("suite", "suite"), "manifest": suite.get("manifest"),
+        "bench_dir": bench_dir, "out_dir": out_dir, "seeds": bench.get("seeds"),
+        "protocol": {
+            "level_1_runs": "per run, each value's maximum over its evaluation points (summary.json max), every "
+                            "side maximised independently",
+            "level_2_pairs": "per pair, mean and SEM over seeds (SEM = sample sd / sqrt(n), 0 for n = 1)",
+            "level_3_axes": "per axis, mean and SEM of the plain pairs' means, each pair weighted equally",
+            "gap": "train_mean - eval_mean, on the means of the level",
+            "drop_pct": "100 * (train_mean - eval_mean) / train_mean, on the means of the level; null where "
+                        "train_mean is 0",
+            "max_abs_diff": "per run the largest |train - eval| at one evaluation point, aggregated like a value",
+        },
+        "metrics": list(METRICS), "markdown_success_column": SUCCESS_SHOWN,
+        "runs_found": status, "levels": levels,
+    }
+    try:
+        write_report(out_dir, result, units, runs)
+    except OSError as e:
+        fail(f"cannot write into {out_dir} ({e}): give a writable directory with --out")
+    return result
+
+
+def write_report(out_dir: str, result: dict, units: List[Unit], runs: Dict[str, List[Run]]) -> None:
+    """The tables, the plots, then report.json (`result`, completed with the files written)."""
+    os.makedirs(out_dir, exist_ok=True)
+    files = write_tables(out_dir, result["suite"], result["levels"], result["runs_found"])
+    result["plots_note"] = None
+    try:
+        files += write_plots(out_dir, units, runs, result["levels"])
+    except ImportError as e:  # the tables do not need matplotlib
+        result["plots_note"] = f"no plots: {e}; install matplotlib (pip install matplotlib) and rerun the report"
+        print(f"kage.bench report: {result['plots_note']}", file=sys.stderr)
+    result["files"] = files + ["report.json"]
+    atomic_write(os.path.join(out_dir, "report.json"), (json.dumps(result, indent=1, allow_nan=False) + "\n").encode())

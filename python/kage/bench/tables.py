@@ -1,0 +1,193 @@
+"""The benchmark report's tables: CSV and Markdown text of the three levels kage.bench.report computes,
+and their files (see its docstring for the protocol). Numbers in Markdown: mean ± SEM to 3 significant
+digits (at most 2 decimals); "-" where a value is missing, "n/a" for an undefined drop."""
+import csv
+import io
+import math
+import os
+from typing import List, Optional, Sequence
+
+from kage.files import atomic_write
+
+METRICS = ("passed_distance", "progress", "success", "success_once", "return", "length", "jump_count")
+SUCCESS_SHOWN = "success_once"
+MARKDOWN_METRICS = (("success", SUCCESS_SHOWN), ("distance", "passed_distance"), ("progress", "progress"),
+                    ("return", "return"))
+SUCCESS_NOTE = (f"success is `{SUCCESS_SHOWN}`: the share of episodes that reached the goal at some step, as in "
+                "the paper's success-rate plots; `success` (past the goal at the episode's end) is in the CSV and "
+                "JSON files.")
+RETURN_NOTE = ("The return is negative for most policies, so its drop is a percentage of a negative train return: "
+               "read the gap.")
+NOTES = {SUCCESS_SHOWN: SUCCESS_NOTE, "return": RETURN_NOTE}
+
+
+VALUE_COLUMNS = ("train_mean", "train_sem", "eval_mean", "eval_sem", "gap", "drop_pct")
+DIFF_COLUMNS = ("max_abs_diff_mean", "max_abs_diff_sem")
+
+
+def value_cells(v: dict) -> list:
+    diff = v["max_abs_diff"] or {}
+    return [v["train"]["mean"], v["train"]["sem"], v["eval"]["mean"], v["eval"]["sem"], v["gap"], v["drop_pct"],
+            diff.get("mean"), diff.get("sem")]
+
+
+def csv_text(header: Sequence[str], rows: List[list]) -> str:
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows([["" if cell is None else cell for cell in row] for row in rows])
+    return out.getvalue()
+
+
+def pairs_csv(pairs: List[dict]) -> str:
+    rows = [[p["pair"], p["axis"], m, p["n_seeds"], *value_cells(p["metrics"][m])] for p in pairs for m in METRICS]
+    return csv_text(("pair", "axis", "metric", "n_seeds") + VALUE_COLUMNS + DIFF_COLUMNS, rows)
+
+
+def axes_csv(axes: List[dict]) -> str:
+    rows = [[a["axis"], m, a["n_pairs"], *value_cells(a["metrics"][m])] for a in axes for m in METRICS]
+    return csv_text(("axis", "metric", "n_pairs") + VALUE_COLUMNS + DIFF_COLUMNS, rows)
+
+
+def sweeps_csv(sweeps: List[dict]) -> str:
+    rows = [[s["sweep"], e["sweep_eval"], s["axis"], m, e["n_seeds"], *value_cells(e["metrics"][m])]
+            for s in sweeps for e in s["evals"] for m in METRICS]
+    return csv_text(("sweep", "sweep_eval", "axis", "metric", "n_seeds") + VALUE_COLUMNS + DIFF_COLUMNS, rows)
+
+
+def runs_csv(level1: List[dict]) -> str:
+    rows = [[r["pair"], r["unit"], r["seed"], m, v["train"], v["eval"], v["gap"], v["drop_pct"], v["max_abs_diff"]]
+            for r in level1 for m, v in r["metrics"].items()]
+    return csv_text(("pair", "unit", "seed", "metric", "train_max", "eval_max", "gap", "drop_pct", "max_abs_diff"),
+                    rows)
+
+
+# ---- Markdown ----
+
+def decimals(value: float) -> int:
+    """Three significant digits, at most two decimals (0.83, 12.3, 480, -3456)."""
+    if value == 0:
+        return 2
+    return min(2, max(0, 2 - math.floor(math.log10(abs(value)))))
+
+
+def fmt_value(value: Optional[float]) -> str:
+    return "-" if value is None else f"{value:.{decimals(value)}f}"
+
+
+def fmt_stat(stat: dict) -> str:
+    """"0.83 ± 0.02": the SEM to the mean's decimals."""
+    if stat["mean"] is None:
+        return "-"
+    d = decimals(stat["mean"])
+    return f"{stat['mean']:.{d}f} ± {stat['sem']:.{d}f}"
+
+
+def fmt_drop(v: dict) -> str:
+    """"-" where a side has no value, "n/a" where the train mean is 0."""
+    if v["gap"] is None:
+        return "-"
+    return "n/a" if v["drop_pct"] is None else f"{v['drop_pct']:.1f} %"
+
+
+def md_table(header: Sequence[str], rows: List[Sequence[str]], text_columns: int) -> str:
+    """A Markdown table, its first `text_columns` columns left-aligned and the numbers right-aligned."""
+    def line(cells):
+        return "| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |"
+    rule = ["---"] * text_columns + ["---:"] * (len(header) - text_columns)
+    return "\n".join([line(header), line(rule)] + [line(r) for r in rows]) + "\n"
+
+
+def metric_title(name: str, metric: str) -> str:
+    return name if name == metric else f"{name} (`{metric}`)"
+
+
+def md_section(level: int, name: str, metric: str, table: str) -> str:
+    """A metric's table under its heading, and the metric's note (which success, what a return drop means)."""
+    note = f"\n{NOTES[metric]}\n" if metric in NOTES else ""
+    return f"{'#' * level} {metric_title(name, metric)}\n\n{table}{note}"
+
+
+def md_axes(axes: List[dict], level: int) -> str:
+    sections = []
+    for name, m in MARKDOWN_METRICS:
+        rows = [[a["axis"], a["n_pairs"], fmt_stat(v["train"]), fmt_stat(v["eval"]), fmt_value(v["gap"]), fmt_drop(v)]
+                for a in axes for v in [a["metrics"][m]]]
+        table = md_table(("axis", "pairs", "train", "eval", "gap", "drop"), rows, 1)
+        sections.append(md_section(level, name, m, table))
+    return "\n".join(sections)
+
+
+def md_pairs(pairs: List[dict], level: int) -> str:
+    sections = []
+    for name, m in MARKDOWN_METRICS:
+        rows = [[p["pair"], p["axis"], p["n_seeds"], fmt_stat(v["train"]), fmt_stat(v["eval"]), fmt_value(v["gap"]),
+                 fmt_drop(v), fmt_stat(v["max_abs_diff"])] for p in pairs for v in [p["metrics"][m]]]
+        table = md_table(("pair", "axis", "seeds", "train", "eval", "gap", "drop", "max abs diff"), rows, 2)
+        sections.append(md_section(level, name, m, table))
+    uncertified = [p["pair"] for p in pairs if p["certified"] is False]
+    if uncertified:
+        sections.append(f"Pairs that kagec did not certify (see suite.json): {', '.join(uncertified)}.\n")
+    return "\n".join(sections)
+
+
+def md_sweeps(sweeps: List[dict], level: int) -> str:
+    sections = []
+    for s in sweeps:
+        first = s["evals"][0]["metrics"]
+        train = ", ".join(f"{name} {fmt_stat(first[m]['train'])}" for name, m in MARKDOWN_METRICS)
+        header = ["eval"]
+        for name, _ in MARKDOWN_METRICS:
+            header += [name, f"{name} drop"]
+        rows = [[e["sweep_eval"]] + [cell for _, m in MARKDOWN_METRICS
+                                     for cell in (fmt_stat(e["metrics"][m]["eval"]), fmt_drop(e["metrics"][m]))]
+                for e in s["evals"]]
+        sections.append(f"{'#' * level} {s['sweep']} ({s['axis']})\n\n"
+                        f"Train config `{s['train_config']}`, mean ± SEM over {s['n_seeds']} seeds: {train}.\n\n"
+                        + md_table(header, rows, 1))
+    return "\n".join(sections) + f"\n{SUCCESS_NOTE} {RETURN_NOTE}\n"
+
+
+PROTOCOL_TEXT = (
+    "Per run, each value's maximum over training (train and eval sides maximised independently); per pair, the "
+    "mean ± SEM over seeds; per axis, the mean ± SEM of the pairs' means, each pair weighted equally. gap = train "
+    "- eval and drop = 100 (train - eval) / train, both on the means of the row; n/a where train is 0. "
+    "\"max abs diff\" is the mean ± SEM of each run's largest |train - eval| at one evaluation point.")
+
+
+def status_text(status: dict) -> str:
+    def listed(runs: List[dict]) -> str:
+        names = [f"{r['unit']} seed {r['seed']}" for r in runs]
+        return ", ".join(names[:10]) + (f" and {len(names) - 10} more" if len(names) > 10 else "")
+    text = f"Runs: {status['finished']} finished"
+    if status["unfinished"]:
+        text += f"; {len(status['unfinished'])} unfinished, not in the tables: {listed(status['unfinished'])}"
+    if status["not_started"]:
+        text += f"; {len(status['not_started'])} not started: {listed(status['not_started'])}"
+    return text + "."
+
+
+def md_document(title: str, status: dict, body: str) -> str:
+    return f"# {title}\n\n{PROTOCOL_TEXT}\n\n{status_text(status)}\n\n{body}"
+
+
+# ---- writing ----
+
+def write_tables(out_dir: str, suite_name: str, levels: dict, status: dict) -> List[str]:
+    """The CSV and Markdown files; returns their names."""
+    files = {"runs.csv": runs_csv(levels["runs"])}
+    combined = []
+    if levels["pairs"]:
+        files["axes.csv"] = axes_csv(levels["axes"])
+        files["pairs.csv"] = pairs_csv(levels["pairs"])
+        files["axes.md"] = md_document(f"{suite_name}: per axis", status, md_axes(levels["axes"], 2))
+        files["pairs.md"] = md_document(f"{suite_name}: per pair", status, md_pairs(levels["pairs"], 2))
+        combined += [f"## Per axis\n\n{md_axes(levels['axes'], 3)}", f"## Per pair\n\n{md_pairs(levels['pairs'], 3)}"]
+    if levels["sweeps"]:
+        files["sweeps.csv"] = sweeps_csv(levels["sweeps"])
+        files["sweeps.md"] = md_document(f"{suite_name}: sweeps", status, md_sweeps(levels["sweeps"], 2))
+        combined.append(f"## Sweeps\n\n{md_sweeps(levels['sweeps'], 3)}")
+    files["report.md"] = md_document(f"{suite_name}: benchmark report", status, "\n".join(combined))
+    for name, text in files.items():
+        atomic_write(os.path.join(out_dir, name), text.encode())
+    return sorted(files)
