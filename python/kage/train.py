@@ -4,40 +4,48 @@ on one or more others, as the original's ppo_jax.py (and ppo_jax_multi_conf.py) 
     python3 -m kage.train --train-config-path T --eval-config-path E --seed S [--device cuda|cpu] [--out DIR]
 
 Read it top to bottom like CleanRL's ppo_atari_envpool.py: the flags (Args), the network, the losses,
-the evaluation, the run directory, then the training loop. "§x.y" refers to the section of the baseline
-specification (kage-ppo-baseline.md) that a line implements. Quirks of the original are kept by default
-and marked QUIRK; a flag offers the corrected behaviour where one makes sense:
+the evaluation, then the training loop. "§x.y" refers to the section of the baseline specification
+(kage-ppo-baseline.md) that a line implements. Quirks of the original are kept by default and marked
+QUIRK; a flag offers the corrected behaviour where one makes sense:
 - truncation is treated as termination (no bootstrap across the 500-step limit): --bootstrap-truncation;
 - evaluation samples its actions: --eval-greedy takes the most likely action instead;
 - `success` is recomputed with a strict `>` at the terminal state, and the plots labelled "success rate"
-  show `success_once`: both are logged, the report says which it shows.
+  show `success_once`: both are logged.
 Not offered: --target-kl (declared and never read by the original), videos, Weights & Biases.
 
-The environment and the learner share the device: observations, actions, rewards and episode metrics
+Packing: the loop trains K runs at once (K = 1 for a lone run; `kage.bench run --pack K`). Each run has its
+own parameters, optimizer state, random streams, environments and run directory, and follows the same
+algorithm as alone; tensors carry a leading run axis [K, ...], and one grouped forward and one backward
+per rollout step and per minibatch serve all K runs, so the learner's kernel launches do not grow with K.
+
+The environments and the learner share the device: observations, actions, rewards and episode metrics
 never leave it during a rollout or an evaluation; the host reads a few scalars once per iteration for
-the log. A run directory holds everything needed to resume a killed run exactly (see RunDir).
+the log. A run directory holds everything needed to resume a killed run exactly (kage.rundir).
 """
 import argparse
+import contextlib
 import dataclasses
+import json
 import math
 import os
-import random
 import sys
 import time
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
-import numpy as np
 import torch
 import torch.nn as nn
+import torch.nn.functional as F
 
 import kage
 from kage import rundir
+from kage.counter_random import CounterRandom
 from kage.wrappers import FrameStack, RewardNormalizer
 
 METRICS = ("x", "y", "vx_mean", "vy_mean", "passed_distance", "progress", "jump_count", "success", "success_once")
 DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # §3.3
 TRAIN_OFFSET, EVAL_OFFSET, EVAL_OFFSET_STEP = 20_000, 10_000, 1_000  # §3.2
+ACTION_STREAM, SHUFFLE_STREAM = 1, 2  # the two random streams of a run (§2.4); evaluations use their own keys
 
 
 @dataclass
@@ -85,6 +93,11 @@ class Args:
     bootstrap_truncation: bool = field(default=False, metadata={
         "help": "bootstrap from the final observation at truncation (QUIRK off: truncation is termination)"})
     eval_greedy: bool = field(default=False, metadata={"help": "greedy evaluation (QUIRK off: sampled actions)"})
+    # Speed (off: plain eager float32; see kage.bench speed)
+    bf16: bool = field(default=False, metadata={"help": "bfloat16 autocast for the network (GPU)"})
+    channels_last: bool = field(default=False, metadata={"help": "channels-last convolutions"})
+    cuda_graph: bool = field(default=False, metadata={"help": "replay the rollout's policy step as a CUDA graph"})
+    compile: bool = field(default=False, metadata={"help": "torch.compile the network (torch 2.x)"})
 
     @property
     def batch_size(self) -> int:
@@ -97,6 +110,11 @@ class Args:
     @property
     def num_iterations(self) -> int:
         return self.total_timesteps // self.batch_size
+
+
+# The arguments that differ between the runs of a pack; the others are the pack's, shared.
+PER_RUN = ("train_config_path", "eval_config_path", "eval_config_paths", "eval_config_labels", "seed", "out",
+           "exp_name")
 
 
 def parse_args(argv: Optional[List[str]] = None) -> Args:
@@ -112,7 +130,13 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
         else:
             kind = next(t for t in (int, float, str) if f.type in (t, Optional[t]))
             parser.add_argument(flag, type=kind, default=default, help=f.metadata["help"])
-    args = Args(**vars(parser.parse_args(argv)))
+    parser.add_argument("--pack", help="train the runs listed in this JSON file together (written by kage.bench)")
+    namespace = vars(parser.parse_args(argv))
+    pack = namespace.pop("pack")
+    if pack:
+        with open(pack) as f:
+            return [Args(**run) for run in json.load(f)["runs"]]
+    args = Args(**namespace)
     problems = validate(args)
     if problems:
         parser.error("; ".join(problems))
@@ -142,6 +166,10 @@ def validate(args: Args) -> List[str]:
         problems.append(f"--eval-config-labels gives {len(args.eval_config_labels)} labels for {n_evals} eval configs")
     if n_evals > 10:
         problems.append("at most 10 eval configs (the 11th would reuse the train config's evaluation seeds, §3.5)")
+    if args.device == "cpu" and (args.bf16 or args.cuda_graph):
+        problems.append("--bf16 and --cuda-graph are for --device cuda")
+    if args.compile and not hasattr(torch, "compile"):
+        problems.append(f"--compile needs torch 2.x; this is torch {torch.__version__}")
     return problems
 
 
@@ -159,60 +187,89 @@ def eval_labels(args: Args) -> List[str]:
 
 # ---- the agent (§1) ----
 
-def layer_init(layer: nn.Module, std: float = math.sqrt(2), bias_const: float = 0.0) -> nn.Module:
-    """Orthogonal weights with gain `std`, constant biases (§1.3)."""
-    nn.init.orthogonal_(layer.weight, std)
-    nn.init.constant_(layer.bias, bias_const)
-    return layer
+def orthogonal(out_features: int, in_features: int, gain: float, device) -> torch.Tensor:
+    """An orthogonal [out, in] matrix with gain `gain` (§1.3), drawn from torch's generator of `device`."""
+    weight = torch.empty(out_features, in_features, device=device)
+    nn.init.orthogonal_(weight, gain)
+    return weight
 
 
 class Agent(nn.Module):
-    """NatureCNN torso (no padding), a 512-unit layer and two linear heads (§1.2)."""
+    """K agents (a pack; K = 1 for a lone run): NatureCNN torsos without padding, a 512-unit layer and two
+    linear heads each (§1.2). Run k owns the k-th group of every grouped convolution and the k-th matrix of
+    every batched linear layer, so one pass per layer evaluates all K."""
 
-    def __init__(self, channels: int = 3, height: int = 128, width: int = 128):
+    def __init__(self, seeds: List[int], channels: int = 3, height: int = 128, width: int = 128, device="cpu"):
         super().__init__()
+        k = self.runs = len(seeds)
+        self.conv1 = nn.Conv2d(k * channels, k * 32, 8, stride=4, groups=k, device=device)
+        self.conv2 = nn.Conv2d(k * 32, k * 64, 4, stride=2, groups=k, device=device)
+        self.conv3 = nn.Conv2d(k * 64, k * 64, 3, stride=1, groups=k, device=device)
         conv_h, conv_w = ((height - 8) // 4 + 1 - 4) // 2 + 1 - 2, ((width - 8) // 4 + 1 - 4) // 2 + 1 - 2
-        self.network = nn.Sequential(
-            layer_init(nn.Conv2d(channels, 32, 8, stride=4)), nn.ReLU(),
-            layer_init(nn.Conv2d(32, 64, 4, stride=2)), nn.ReLU(),
-            layer_init(nn.Conv2d(64, 64, 3, stride=1)), nn.ReLU(),
-            nn.Flatten(),
-            layer_init(nn.Linear(64 * conv_h * conv_w, 512)), nn.ReLU(),
-        )
-        self.actor = layer_init(nn.Linear(512, 8), std=0.01)
-        self.critic = layer_init(nn.Linear(512, 1), std=1.0)
+        self.flat = 64 * conv_h * conv_w
+        self.fc_weight = nn.Parameter(torch.empty(k, self.flat, 512, device=device))
+        self.fc_bias = nn.Parameter(torch.zeros(k, 1, 512, device=device))
+        self.actor_weight = nn.Parameter(torch.empty(k, 512, 8, device=device))
+        self.actor_bias = nn.Parameter(torch.zeros(k, 1, 8, device=device))
+        self.critic_weight = nn.Parameter(torch.empty(k, 512, 1, device=device))
+        self.critic_bias = nn.Parameter(torch.zeros(k, 1, 1, device=device))
+        with torch.no_grad():
+            for run, seed in enumerate(seeds):
+                self._initialise(run, seed, channels)
 
-    def features(self, obs: torch.Tensor) -> torch.Tensor:
-        """uint8 [B, H, W, C] frames -> [B, 512]; the first operation is /255 in float32 (§1.1)."""
-        return self.network(obs.permute(0, 3, 1, 2).float() / 255.0)
+    def _initialise(self, run: int, seed: int, channels: int) -> None:
+        """§1.3: orthogonal weights (gain sqrt 2 in the torso, 0.01 actor, 1 critic), zero biases; from the
+        run's seed, so a run starts the same alone or packed."""
+        torch.manual_seed(seed)
+        for conv, in_channels in ((self.conv1, channels), (self.conv2, 32), (self.conv3, 64)):
+            out, _, kh, kw = conv.weight.shape
+            out //= self.runs
+            group = conv.weight.view(self.runs, out, in_channels, kh, kw)[run]
+            group.copy_(orthogonal(out, in_channels * kh * kw, math.sqrt(2), group.device).view_as(group))
+            conv.bias.view(self.runs, out)[run].zero_()
+        for weight, gain in ((self.fc_weight, math.sqrt(2)), (self.actor_weight, 0.01), (self.critic_weight, 1.0)):
+            weight[run].copy_(orthogonal(weight.shape[2], weight.shape[1], gain, weight.device).T)
 
-    def get_value(self, obs: torch.Tensor) -> torch.Tensor:
-        return self.critic(self.features(obs)).squeeze(-1)
+    def forward(self, obs: torch.Tensor):
+        """uint8 [K, B, H, W, C] frames -> logits [K, B, 8] and values [K, B]. The first operation is the
+        conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups."""
+        k, b, h, w, c = obs.shape
+        frames = obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c).permute(0, 3, 1, 2)  # channels last
+        x = frames.float() / 255.0
+        if not self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
+            x = x.contiguous()
+        x = F.relu(self.conv1(x))
+        x = F.relu(self.conv2(x))
+        x = F.relu(self.conv3(x))
+        x = x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
+        hidden = F.relu(torch.baddbmm(self.fc_bias, x, self.fc_weight))
+        logits = torch.baddbmm(self.actor_bias, hidden, self.actor_weight)
+        value = torch.baddbmm(self.critic_bias, hidden, self.critic_weight).squeeze(-1)
+        return logits, value
 
-    def get_logits_and_value(self, obs: torch.Tensor):
-        hidden = self.features(obs)
-        return self.actor(hidden), self.critic(hidden).squeeze(-1)
+    def run_view(self, tensor: torch.Tensor) -> torch.Tensor:
+        """A tensor shaped like a parameter (the parameter, its gradient, an Adam moment) as [K, ...]: the
+        leading axis split into the runs' parts, whatever the memory format."""
+        return tensor.unflatten(0, (self.runs, -1))
 
 
-def sample_gumbel_max(logits: torch.Tensor, generator: torch.Generator):
-    """Categorical sampling by the Gumbel-max trick, as the rollout does (§1.4): the action and its
-    log-probability."""
-    u = torch.rand(logits.shape, generator=generator, device=logits.device)
-    action = torch.argmax(logits - torch.log(-torch.log(u)), dim=1)
-    logprob = torch.log_softmax(logits, dim=1).gather(1, action[:, None]).squeeze(1)
+def sample_gumbel_max(logits: torch.Tensor, uniform: torch.Tensor):
+    """Categorical sampling by the Gumbel-max trick (§1.4): the action and its log-probability."""
+    action = torch.argmax(logits - torch.log(-torch.log(uniform)), dim=-1)
+    logprob = torch.log_softmax(logits.float(), dim=-1).gather(-1, action[..., None]).squeeze(-1)
     return action, logprob
 
 
 def entropy_of(logits: torch.Tensor) -> torch.Tensor:
     """Entropy from log-softmax logits clipped at the smallest float32, so p log p is never 0 * -inf."""
-    log_p = torch.log_softmax(logits, dim=1).clamp(min=torch.finfo(logits.dtype).min)
-    return -(log_p.exp() * log_p).sum(1)
+    log_p = torch.log_softmax(logits, dim=-1).clamp(min=torch.finfo(logits.dtype).min)
+    return -(log_p.exp() * log_p).sum(-1)
 
 
-# ---- the algorithm's arithmetic (§2.5 step 3, §2.6) ----
+# ---- the algorithm's arithmetic (§2.5 step 3, §2.6), with any leading run axes ----
 
 def compute_gae(rewards, values, dones, next_value, next_done, gamma: float, gae_lambda: float):
-    """Advantages and returns over a [T, N] rollout (§2.5 step 3). dones[t] is true iff obs[t] starts an
+    """Advantages and returns over a [T, ...] rollout (§2.5 step 3). dones[t] is true iff obs[t] starts an
     episode; next_done / next_value belong to the observation after the last step."""
     num_steps = rewards.shape[0]
     advantages = torch.zeros_like(rewards)
@@ -229,22 +286,24 @@ def compute_gae(rewards, values, dones, next_value, next_done, gamma: float, gae
 
 
 def ppo_loss(new_logprob, entropy, new_value, old_logprob, old_value, advantages, returns, args: Args, ent_coef: float):
-    """The minibatch loss of §2.6 and its diagnostics: (loss, pg_loss, v_loss, entropy, approx_kl, clipfrac)."""
+    """The minibatch loss of §2.6 and its diagnostics, reduced over the last axis (a run's minibatch):
+    (loss, pg_loss, v_loss, entropy, approx_kl, clipfrac), each [K] (or a scalar without a run axis)."""
     logratio = new_logprob - old_logprob
     ratio = logratio.exp()
     with torch.no_grad():
-        approx_kl = ((ratio - 1) - logratio).mean()
-        clipfrac = ((ratio - 1.0).abs() > args.clip_coef).float().mean()
+        approx_kl = ((ratio - 1) - logratio).mean(-1)
+        clipfrac = ((ratio - 1.0).abs() > args.clip_coef).float().mean(-1)
     if args.norm_adv:
         # Population standard deviation (divide by n), as the original's jnp.std.
-        advantages = (advantages - advantages.mean()) / (advantages.std(unbiased=False) + 1e-8)
-    pg_loss = torch.max(-advantages * ratio, -advantages * ratio.clamp(1 - args.clip_coef, 1 + args.clip_coef)).mean()
+        mean = advantages.mean(-1, keepdim=True)
+        advantages = (advantages - mean) / (advantages.std(-1, unbiased=False, keepdim=True) + 1e-8)
+    pg_loss = torch.max(-advantages * ratio, -advantages * ratio.clamp(1 - args.clip_coef, 1 + args.clip_coef)).mean(-1)
     if args.clip_vloss:
         v_clipped = old_value + (new_value - old_value).clamp(-args.clip_coef, args.clip_coef)
-        v_loss = 0.5 * torch.max((new_value - returns) ** 2, (v_clipped - returns) ** 2).mean()
+        v_loss = 0.5 * torch.max((new_value - returns) ** 2, (v_clipped - returns) ** 2).mean(-1)
     else:
-        v_loss = 0.5 * ((new_value - returns) ** 2).mean()
-    entropy_loss = entropy.mean()
+        v_loss = 0.5 * ((new_value - returns) ** 2).mean(-1)
+    entropy_loss = entropy.mean(-1)
     loss = pg_loss - ent_coef * entropy_loss + v_loss * args.vf_coef
     return loss, pg_loss, v_loss, entropy_loss, approx_kl, clipfrac
 
@@ -257,61 +316,82 @@ def entropy_coefficient(args: Args, optimizer_steps: int) -> float:
     return args.ent_coef * min(max(1.0 - optimizer_steps / total, 0.0), 1.0)
 
 
+def clip_grad_norm_per_run(agent: Agent, max_norm: float) -> torch.Tensor:
+    """Scales each run's gradients by max_norm / max(norm, max_norm), its norm taken over all its
+    parameters (Optax's clip_by_global_norm, §2.1); returns the [K] norms."""
+    grads = [agent.run_view(p.grad) for p in agent.parameters()]
+    norm = torch.stack([g.pow(2).sum(tuple(range(1, g.dim()))) for g in grads]).sum(0).sqrt()
+    scale = max_norm / torch.maximum(norm, torch.full_like(norm, max_norm))
+    for g in grads:
+        g.mul_(scale.view(-1, *[1] * (g.dim() - 1)))
+    return norm
+
+
 # ---- episode metrics (§4) ----
 
 class EpisodeMetrics:
-    """Device views of a batch's finished-episode fields, read each step without a copy (§4.1)."""
+    """Device views of the finished-episode fields of a list of batches, read each step without a copy
+    (§4.1): the k-th row is the k-th batch."""
 
-    def __init__(self, env: "kage.VecEnv", info: dict, dist_to_success: float):
-        final = info["final_info"]
-        self.mask = torch.from_dlpack(info["_final"])
-        self.fields = {name: torch.from_dlpack(final[name]) for name in ("return", "length") + METRICS}
-        self.dist_to_success = dist_to_success
+    def __init__(self, infos: List[dict], dists_to_success: List[float], device):
+        self.masks = [torch.from_dlpack(info["_final"]) for info in infos]
+        names = ("return", "length") + METRICS
+        self.fields = {n: [torch.from_dlpack(info["final_info"][n]) for info in infos] for n in names}
+        self.dist_to_success = torch.tensor(dists_to_success, device=device)[:, None]
+
+    def mask(self) -> torch.Tensor:
+        return torch.stack(self.masks).float()
 
     def rows(self) -> torch.Tensor:
-        """[12, N] float32: finished mask, return, length and the nine metrics of §4.1. QUIRK: success is
+        """[K, 12, N] float32: finished mask, return, length and the nine metrics of §4.1. QUIRK: success is
         recomputed with a strict > at the terminal state (the core uses >=)."""
-        f = self.fields
-        success = (f["passed_distance"] > self.dist_to_success).float()
-        values = [self.mask.float(), f["return"], f["length"].float()]
-        values += [success if m == "success" else f[m].float() for m in METRICS]
-        return torch.stack(values)
+        f = {n: torch.stack(v).float() for n, v in self.fields.items()}
+        f["success"] = (f["passed_distance"] > self.dist_to_success).float()
+        return torch.stack([self.mask(), f["return"], f["length"]] + [f[m] for m in METRICS], dim=1)
 
 
 @torch.no_grad()
-def evaluate(agent: Agent, envs: List["kage.VecEnv"], seeds: List[int], dists_to_success: List[float], episodes: int,
-             episode_length: int, greedy: bool, frame_stack: bool) -> List[Dict[str, Optional[float]]]:
-    """The evaluations of several configs (§3.2), each in fresh environments with its own seed and
-    sampling stream, stepped together: one forward pass per step for all their environments. Sampled
-    actions until `episodes` episodes have finished in each. Steps are queued without a host
+def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]], dists: List[List[float]],
+             episodes: int, episode_length: int, args: Args) -> List[List[Dict[str, Optional[float]]]]:
+    """The evaluations of each run's configs (§3.2; envs[k][c]: run k's c-th config), each in fresh
+    environments with its own seed and sampling stream, all stepped together: one forward pass per step.
+    Sampled actions until `episodes` episodes have finished in each. Steps are queued without a host
     synchronisation: every KAGE episode ends by truncation at `episode_length` (§2.3), so
     ceil(episodes / envs) waves of episode_length steps finish them; the host checks the counts once,
     after the waves (and steps on, a wave at a time, if one fell short)."""
     device = next(agent.parameters()).device
-    generators = [torch.Generator(device=device).manual_seed(seed) for seed in seeds]
-    frames, stacks, metrics = [], [], []
-    for env, seed, dist in zip(envs, seeds, dists_to_success):
-        obs, info = env.reset(seed=seed)
-        frames.append(torch.from_dlpack(obs))
-        stacks.append(FrameStack(frames[-1]) if frame_stack else None)
-        metrics.append(EpisodeMetrics(env, info, dist))
-    chunk = -(-episodes // min(env.num_envs for env in envs)) * episode_length
-    records: List[List[torch.Tensor]] = [[] for _ in envs]
+    flat_envs = [e for run in envs for e in run]
+    configs, n = len(envs[0]), flat_envs[0].num_envs
+    random = CounterRandom([s for run in seeds for s in run], device)
+    counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
+    infos = []
+    for env, seed in zip(flat_envs, [s for run in seeds for s in run]):
+        infos.append(env.reset(seed=seed)[1])
+    frames = [torch.from_dlpack(env.outputs()[0]) for env in flat_envs]
+    metrics = EpisodeMetrics(infos, [d for run in dists for d in run], device)
+    stack = FrameStack(torch.stack(frames)) if args.use_frame_stack else None
+    chunk = -(-episodes // n) * episode_length
+    records, step = [], 0
     while True:
         for _ in range(chunk):
-            x = torch.cat([s.stack if s else f for f, s in zip(frames, stacks)])
-            logits = agent.actor(agent.features(x)).split([env.num_envs for env in envs])
-            for env, logit, generator, frame, stack, metric, record in zip(envs, logits, generators, frames, stacks,
-                                                                           metrics, records):
-                # QUIRK: sampled, not greedy. Gumbel-max is an exact categorical sampler with no host check.
-                env.step(logit.argmax(1) if greedy else sample_gumbel_max(logit, generator)[0])
-                if stack:
-                    stack.push(frame, metric.mask)
-                record.append(metric.rows())
-        counts = torch.stack([torch.stack(r)[:, 0].sum() for r in records]).tolist()
-        if min(counts) >= episodes:
+            obs = stack.stack if stack else torch.stack(frames)             # [K * C, E, H, W, ch]
+            with autocast(args):
+                logits, _ = agent(obs.view(len(envs), configs * n, *obs.shape[2:]))
+            logits = logits.float().view(len(flat_envs), n, 8)
+            # QUIRK: sampled, not greedy (Gumbel-max: an exact categorical sampler with no host check).
+            uniform = random.uniform(0, counter.fill_(step), (n, 8))
+            actions = logits.argmax(-1) if args.eval_greedy else sample_gumbel_max(logits, uniform)[0]
+            for env, action in zip(flat_envs, actions):
+                env.step(action)
+            if stack:
+                stack.push(torch.stack(frames), metrics.mask())
+            records.append(metrics.rows())
+            step += 1
+        if torch.stack(records)[:, :, 0].sum((0, 2)).min().item() >= episodes:  # the one host read
             break
-    return [summarize_evaluation(torch.stack(r).cpu(), episodes) for r in records]
+    host = torch.stack(records).cpu()
+    results = [summarize_evaluation(host[:, i], episodes) for i in range(len(flat_envs))]
+    return [results[k * configs:(k + 1) * configs] for k in range(len(envs))]
 
 
 def summarize_evaluation(records: torch.Tensor, episodes: int) -> Dict[str, Optional[float]]:
@@ -322,9 +402,7 @@ def summarize_evaluation(records: torch.Tensor, episodes: int) -> Dict[str, Opti
     finished = records[:, 0] > 0                                           # [S, N]
     per_step = finished.sum(1).cumsum(0)
     last_step = int(torch.nonzero(per_step >= episodes)[0]) if bool((per_step >= episodes).any()) else len(per_step) - 1
-    upto = records[: last_step + 1]
-    mask = finished[: last_step + 1]
-    values = upto.permute(0, 2, 1)[mask]                                   # [episodes finished, 12], step-major
+    values = records[: last_step + 1].permute(0, 2, 1)[finished[: last_step + 1]]  # [finished, 12], step-major
     listed = values[:episodes]
     nonzero = listed[:, 1] != 0
     result: Dict[str, Optional[float]] = {
@@ -338,42 +416,95 @@ def summarize_evaluation(records: torch.Tensor, episodes: int) -> Dict[str, Opti
     return result
 
 
-def evaluation_point(agent, eval_envs, args: Args, iteration: int, global_step: int, specs) -> dict:
-    """Evaluates the current parameters on the train config and on each eval config (§3.2; seed offsets
-    20,000 for the train config, 10,000 + 1,000 i for the i-th eval config), and the absolute
-    differences train - eval (§3.3)."""
-    start = time.perf_counter()
-    was_training = agent.training
-    agent.eval()
-    labels = list(eval_envs)
-    seeds = [args.seed + (TRAIN_OFFSET if i == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * (i - 1)) + iteration
-             for i in range(len(labels))]
-    configs = [specs[label]["config"] for label in labels]
-    results = dict(zip(labels, evaluate(agent, list(eval_envs.values()), seeds,
-                                        [c["dist_to_success"] for c in configs], args.eval_episodes,
-                                        max(c["episode_length"] for c in configs), args.eval_greedy,
-                                        args.use_frame_stack)))
-    agent.train(was_training)
-    train_label, *labels = list(eval_envs)
-    diffs = {label: {m: absolute_difference(results[train_label][m], results[label][m]) for m in DIFF_METRICS}
-             for label in labels}
-    return {"kind": "eval", "iteration": iteration, "global_step": global_step, "train": results[train_label],
-            "evals": {label: results[label] for label in labels}, "diffs": diffs,
-            "seconds": time.perf_counter() - start}
-
-
 def absolute_difference(a: Optional[float], b: Optional[float]) -> Optional[float]:
     return None if a is None or b is None else abs(a - b)
 
 
+def evaluation_rows(agent: Agent, runs: List["Run"], args: Args, iteration: int, global_step: int) -> List[dict]:
+    """Evaluates each run's current parameters on its train config and on each eval config (§3.2; seed
+    offsets 20,000 for the train config, 10,000 + 1,000 i for the i-th eval config), and the absolute
+    differences train - eval (§3.3): one log row per run."""
+    start = time.perf_counter()
+    agent.eval()
+    seeds = [[r.args.seed + (TRAIN_OFFSET if i == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * (i - 1)) + iteration
+              for i in range(len(r.eval_envs))] for r in runs]
+    configs = [[r.specs[label]["config"] for label in r.eval_envs] for r in runs]
+    results = evaluate(agent, [list(r.eval_envs.values()) for r in runs], seeds,
+                       [[c["dist_to_success"] for c in run] for run in configs], args.eval_episodes,
+                       max(c["episode_length"] for run in configs for c in run), args)
+    agent.train()
+    rows = []
+    for run, result in zip(runs, results):
+        train, *evals = result
+        labels = list(run.eval_envs)[1:]
+        rows.append({"kind": "eval", "iteration": iteration, "global_step": global_step, "train": train,
+                     "evals": dict(zip(labels, evals)),
+                     "diffs": {label: {m: absolute_difference(train[m], ev[m]) for m in DIFF_METRICS}
+                               for label, ev in zip(labels, evals)},
+                     "seconds": time.perf_counter() - start})
+    return rows
+
+
+# ---- the runs of a pack ----
+
+@dataclass
+class Run:
+    """What a run owns besides its slice of the network: its arguments, directory and environments."""
+    args: Args
+    dir: rundir.RunDir
+    env: "kage.VecEnv"
+    eval_envs: Dict[str, "kage.VecEnv"]  # "train", then the eval configs by label
+    specs: Dict[str, dict]
+    history: List[dict] = field(default_factory=list)
+
+
+def open_run(args: Args, threads: int) -> Run:
+    run_dir = rundir.RunDir.open(args, labels=eval_labels(args))
+    env = kage.make_vec(args.train_config_path, args.num_envs, device=args.device, seed=args.seed,
+                        asset_root=args.asset_root, threads=threads)
+    eval_envs = {}
+    if args.run_eval_every > 0 and args.eval_episodes > 0 and args.eval_num_envs > 0:
+        for label, path in [("train", args.train_config_path)] + list(zip(eval_labels(args), eval_paths(args))):
+            eval_envs[label] = kage.make_vec(path, args.eval_num_envs, device=args.device, asset_root=args.asset_root,
+                                             threads=threads)
+    return Run(args, run_dir, env, eval_envs, run_dir.specs)
+
+
+def check_pack(runs: List[Args]) -> Args:
+    """The pack's shared arguments: every run must agree on all but PER_RUN and on the number of eval configs."""
+    first = dataclasses.asdict(runs[0])
+    for args in runs[1:]:
+        other = dataclasses.asdict(args)
+        differ = [k for k in first if k not in PER_RUN and first[k] != other[k]]
+        if differ:
+            raise SystemExit(f"kage.train: packed runs must share {', '.join(differ)}")
+        if len(eval_paths(args)) != len(eval_paths(runs[0])):
+            raise SystemExit("kage.train: packed runs must evaluate the same number of configs")
+    return runs[0]
+
+
+def autocast(args: Args):
+    """bfloat16 autocast for the network under --bf16, else nothing."""
+    return torch.autocast("cuda", dtype=torch.bfloat16) if args.bf16 else contextlib.nullcontext()
+
+
+class NoTimer:
+    """The phases of an iteration, timed only by kage.bench speed (kage.bench.speed.PhaseTimer)."""
+
+    def __call__(self, phase: str):
+        return contextlib.nullcontext()
+
+    def end_iteration(self) -> None:
+        pass
+
+
 # ---- the training loop (§2.5) ----
 
-def main(argv: Optional[List[str]] = None) -> int:
-    args = parse_args(argv)
-    run = rundir.RunDir.open(args, labels=eval_labels(args))
-    if run.finished:
-        print(f"kage.train: {run.path} is finished (summary.json); nothing to do", file=sys.stderr)
-        return 0
+def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> List[Run]:
+    """Trains the runs of `pack` together (one for a lone run) to the end, or `stop_after` iterations past
+    where they start (kage.bench speed). Resumes each run from its checkpoint if it has one."""
+    args = check_pack(pack)
+    timer = timer or NoTimer()
     if args.device == "cuda" and not torch.cuda.is_available():
         raise SystemExit("kage.train: --device cuda, but torch sees no GPU: use --device cpu")
     device = torch.device(args.device)
@@ -383,181 +514,293 @@ def main(argv: Optional[List[str]] = None) -> int:
         torch.backends.cudnn.benchmark = True
         torch.set_float32_matmul_precision("high")  # TF32, as JAX's default precision on this GPU
 
-    # §2.4: one seed for Python, numpy and torch (the network's initialisation); the rollout's own stream.
-    random.seed(args.seed)
-    np.random.seed(args.seed)
-    torch.manual_seed(args.seed)
-    rng = torch.Generator(device=device).manual_seed(args.seed)
-
-    specs = run.specs
-    train_spec = specs["train"]["config"]
-    env = kage.make_vec(args.train_config_path, args.num_envs, device=args.device, seed=args.seed,
-                        asset_root=args.asset_root, threads=threads)
-    eval_envs = {}
-    if args.run_eval_every > 0 and args.eval_episodes > 0 and args.eval_num_envs > 0:
-        for label, path in [("train", args.train_config_path)] + list(zip(eval_labels(args), eval_paths(args))):
-            eval_envs[label] = kage.make_vec(path, args.eval_num_envs, device=args.device, asset_root=args.asset_root,
-                                             threads=threads)
-    height, width, channels = env.single_observation_space.shape
+    runs = [open_run(a, threads) for a in pack]
+    K, T, N = len(runs), args.num_steps, args.num_envs
+    height, width, channels = runs[0].env.single_observation_space.shape
     channels *= 4 if args.use_frame_stack else 1
-    agent = Agent(channels, height, width).to(device)
+    agent = Agent([a.seed for a in pack], channels, height, width, device)  # §2.4: the runs' seeds
+    if args.channels_last:
+        agent = agent.to(memory_format=torch.channels_last)
+    policy = torch.compile(agent) if args.compile else agent
     optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5)
+    random = CounterRandom([a.seed for a in pack], device)
+    counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
 
-    # Rollout storage, [T, N, ...] on the device (§2.5 step 1d).
-    T, N = args.num_steps, args.num_envs
-    obs = torch.zeros((T, N, height, width, channels), dtype=torch.uint8, device=device)
-    actions = torch.zeros((T, N), dtype=torch.long, device=device)
-    logprobs = torch.zeros((T, N), device=device)
-    rewards = torch.zeros((T, N), device=device)
-    dones = torch.zeros((T, N), device=device)
-    values = torch.zeros((T, N), device=device)
+    # Rollout storage, [T, K, N, ...] on the device (§2.5 step 1d).
+    obs = torch.zeros((T, K, N, height, width, channels), dtype=torch.uint8, device=device)
+    actions = torch.zeros((T, K, N), dtype=torch.long, device=device)
+    logprobs, rewards, dones, values = (torch.zeros((T, K, N), device=device) for _ in range(4))
 
-    env.reset(seed=kage.env_seeds(args.seed, N))
     # Views of the runtime's buffers, which every step rewrites in place.
-    env_obs, env_reward, env_terminated, env_truncated, env_info = env.outputs()
-    frame = torch.from_dlpack(env_obs)
-    env_reward, env_terminated, env_truncated = (torch.from_dlpack(a) for a in (env_reward, env_terminated, env_truncated))
-    episode = EpisodeMetrics(env, env_info, train_spec["dist_to_success"])
-    final_obs = torch.from_dlpack(env_info["final_obs"])
-    stack = FrameStack(frame) if args.use_frame_stack else None
-    normalizer = RewardNormalizer(N, args.gamma, device) if args.normalize_reward else None
-    next_obs = stack.stack if stack else frame
-    next_done = torch.zeros(N, device=device)
-    last_return = torch.zeros(N, device=device)  # §4.2: each environment's most recent episode
-    last_length = torch.zeros(N, device=device)
-    any_finished = torch.zeros((), dtype=torch.bool, device=device)
-    history: List[dict] = []
+    infos = []
+    for run in runs:
+        infos.append(run.env.reset(seed=kage.env_seeds(run.args.seed, N))[1])
+    outputs = [run.env.outputs() for run in runs]
+    frames = [torch.from_dlpack(o[0]) for o in outputs]
+    env_reward, env_terminated, env_truncated = ([torch.from_dlpack(o[i]) for o in outputs] for i in (1, 2, 3))
+    final_frames = [torch.from_dlpack(info["final_obs"]) for info in infos]
+    episode = EpisodeMetrics(infos, [r.specs["train"]["config"]["dist_to_success"] for r in runs], device)
+    stack = FrameStack(torch.stack(frames)) if args.use_frame_stack else None
+    normalizer = RewardNormalizer((K, N), args.gamma, device) if args.normalize_reward else None
+    next_done = torch.zeros((K, N), device=device)
+    last_return = torch.zeros((K, N), device=device)  # §4.2: each environment's most recent episode
+    last_length = torch.zeros((K, N), device=device)
+    any_finished = torch.zeros(K, dtype=torch.bool, device=device)
     start_iteration, global_step, optimizer_steps, train_seconds = 1, 0, 0, 0.0
 
-    checkpoint = run.load_checkpoint(device)
-    if checkpoint is not None:  # resume: everything the loop carries, then the environments' state
-        agent.load_state_dict(checkpoint["agent"])
-        optimizer.load_state_dict(checkpoint["optimizer"])
-        rng.set_state(checkpoint["rng"])
-        torch.set_rng_state(checkpoint["torch_rng"])
-        env.load_state(checkpoint["env_state"])
-        next_done, last_return, last_length = (checkpoint[k].to(device) for k in ("next_done", "last_return", "last_length"))
-        any_finished = checkpoint["any_finished"].to(device)
-        if stack:
-            stack.stack = checkpoint["frame_stack"].to(device)
-        if normalizer:
-            normalizer.load_state_dict({k: v.to(device) for k, v in checkpoint["normalizer"].items()})
-        next_obs = stack.stack if stack else frame
-        history = checkpoint["history"]
-        start_iteration, global_step = checkpoint["iteration"] + 1, checkpoint["global_step"]
-        optimizer_steps, train_seconds = checkpoint["optimizer_steps"], checkpoint["train_seconds"]
-        print(f"kage.train: resuming {run.path} after iteration {checkpoint['iteration']}", file=sys.stderr)
-    elif eval_envs:
-        history.append(run.log(evaluation_point(agent, eval_envs, args, 0, 0, specs)))  # §3.1: the untrained policy
+    def observe() -> torch.Tensor:
+        """The runs' current observations, [K, N, H, W, C]."""
+        return stack.stack if stack else torch.stack(frames)
 
-    def save_checkpoint(iteration: int) -> None:
-        run.save_checkpoint({
-            "iteration": iteration, "global_step": global_step, "optimizer_steps": optimizer_steps,
-            "train_seconds": train_seconds, "agent": agent.state_dict(), "optimizer": optimizer.state_dict(),
-            "rng": rng.get_state(), "torch_rng": torch.get_rng_state(), "env_state": env.save_state(),
-            "next_done": next_done, "last_return": last_return, "last_length": last_length,
-            "any_finished": any_finished, "frame_stack": stack.stack if stack else None,
-            "normalizer": normalizer.state_dict() if normalizer else None, "history": history,
-        })
+    checkpoints = [run.dir.load_checkpoint(device) for run in runs]
+    if any(c is not None for c in checkpoints):  # resume: the loop state, then the environments' state
+        if any(c is None or c["iteration"] != checkpoints[0]["iteration"] for c in checkpoints):
+            raise SystemExit("kage.train: packed runs resume together from checkpoints of one iteration; "
+                             "pack them by the iteration they reached")
+        for k, (run, c) in enumerate(zip(runs, checkpoints)):
+            with torch.no_grad():
+                for name, p in agent.named_parameters():
+                    agent.run_view(p)[k].copy_(c["agent"][name])
+            run.env.load_state(c["env_state"])
+            for tensor, key in ((next_done, "next_done"), (last_return, "last_return"), (last_length, "last_length"),
+                                (any_finished, "any_finished")):
+                tensor[k] = c[key].to(device)
+            if stack:
+                stack.stack[k] = c["frame_stack"].to(device)
+            if normalizer:
+                for name, value in c["normalizer"].items():
+                    getattr(normalizer, name)[k] = value.to(device)
+            run.history = c["history"]
+        load_optimizer(optimizer, agent, [c["optimizer"] for c in checkpoints])
+        c = checkpoints[0]
+        start_iteration, global_step = c["iteration"] + 1, c["global_step"]
+        optimizer_steps, train_seconds = c["optimizer_steps"], c["train_seconds"]
+        for run in runs:
+            print(f"kage.train: resuming {run.dir.path} after iteration {c['iteration']}", file=sys.stderr)
+    elif runs[0].eval_envs:
+        with timer("eval"):  # §3.1: the untrained policy
+            for run, row in zip(runs, evaluation_rows(agent, runs, args, 0, 0)):
+                run.history.append(run.dir.log(row))
 
-    progress = rundir.Progress(args.num_iterations, args.batch_size)
-    for iteration in range(start_iteration, args.num_iterations + 1):
+    def save_checkpoints(iteration: int) -> None:
+        for k, run in enumerate(runs):
+            run.dir.save_checkpoint({
+                "iteration": iteration, "global_step": global_step, "optimizer_steps": optimizer_steps,
+                "train_seconds": train_seconds,
+                "agent": {n: agent.run_view(p)[k].detach().cpu().clone() for n, p in agent.named_parameters()},
+                "optimizer": optimizer_run_state(optimizer, agent, k), "env_state": run.env.save_state(),
+                "next_done": next_done[k].cpu(), "last_return": last_return[k].cpu(),
+                "last_length": last_length[k].cpu(), "any_finished": any_finished[k].cpu(),
+                "frame_stack": stack.stack[k].cpu() if stack else None,
+                "normalizer": {n: v[k].cpu() for n, v in normalizer.state_dict().items()} if normalizer else None,
+                "history": run.history})
+
+    progress = rundir.Progress(args.num_iterations, args.batch_size * K)
+    last_iteration = args.num_iterations if stop_after is None else min(args.num_iterations,
+                                                                        start_iteration + stop_after - 1)
+    rollout = RolloutPolicy(policy, random, args, observe().shape, device)
+    for iteration in range(start_iteration, last_iteration + 1):
         iteration_start = time.perf_counter()
         if args.anneal_lr:  # §2.6
             optimizer.param_groups[0]["lr"] = args.learning_rate * (1.0 - (iteration - 1.0) / args.num_iterations)
-        episode_sums = torch.zeros(len(METRICS) + 1, device=device)  # count, then the nine metrics
+        episode_sums = torch.zeros((K, len(METRICS) + 1), device=device)  # count, then the nine metrics
 
         for step in range(T):  # §2.5 step 1
-            obs[step] = next_obs
-            dones[step] = next_done
-            with torch.no_grad():
-                logits, value = agent.get_logits_and_value(next_obs)
-                action, logprob = sample_gumbel_max(logits, rng)
-            values[step], actions[step], logprobs[step] = value, action, logprob
-            env.step(action)
-            reward = env_reward.clone()
-            next_done = (env_terminated | env_truncated).float()  # QUIRK: truncation is termination (§2.5 b)
-            rows = episode.rows()
-            finished = rows[0]
-            if args.bootstrap_truncation:
-                with torch.no_grad():  # the value of the observation the truncation discarded
-                    reward += args.gamma * agent.get_value(final_obs) * env_truncated.float() * finished
-            if normalizer:
-                reward = normalizer(reward, next_done)
-            rewards[step] = reward.clamp(args.reward_clip_min, args.reward_clip_max)
-            # §4.2: sums of the finished episodes' metrics; each environment's latest return and length.
-            episode_sums += torch.cat([finished.sum()[None], (rows[3:] * finished).sum(1)])
-            last_return = torch.where(finished > 0, rows[1], last_return)
-            last_length = torch.where(finished > 0, rows[2], last_length)
-            any_finished |= finished.any()
-            next_obs = stack.push(frame, next_done) if stack else frame
+            with timer("forward"):
+                obs[step] = observe()
+                dones[step] = next_done
+                # The counter names this draw (iteration, step): the same numbers alone, packed or resumed.
+                action, logprob, value = rollout(obs[step], (iteration - 1) * T + step)
+                values[step], actions[step], logprobs[step] = value, action, logprob
+            with timer("env"):
+                for run, a in zip(runs, action):
+                    run.env.step(a)
+                reward = torch.stack(env_reward)
+                next_done = (torch.stack(env_terminated) | torch.stack(env_truncated)).float()  # QUIRK (§2.5 b)
+                rows = episode.rows()
+                finished = rows[:, 0]
+                if args.bootstrap_truncation:
+                    with torch.no_grad(), autocast(args):  # the value of the observation the truncation discarded
+                        truncated = torch.stack(env_truncated).float() * finished
+                        reward = reward + args.gamma * policy(torch.stack(final_frames))[1].float() * truncated
+                if normalizer:
+                    reward = normalizer(reward, next_done)
+                rewards[step] = reward.clamp(args.reward_clip_min, args.reward_clip_max)
+                # §4.2: sums of the finished episodes' metrics; each environment's latest return and length.
+                episode_sums += torch.cat([finished.sum(1, keepdim=True), (rows[:, 3:] * finished[:, None]).sum(2)], 1)
+                last_return = torch.where(finished > 0, rows[:, 1], last_return)
+                last_length = torch.where(finished > 0, rows[:, 2], last_length)
+                any_finished |= finished.any(1)
+                if stack:
+                    stack.push(torch.stack(frames), next_done)
         global_step += args.batch_size  # §2.5 step 2
 
-        with torch.no_grad():  # §2.5 step 3
-            next_value = agent.get_value(next_obs)
+        with torch.no_grad(), timer("forward"):  # §2.5 step 3
+            with autocast(args):
+                next_value = policy(observe())[1].float()
             advantages, returns = compute_gae(rewards, values, dones, next_value, next_done, args.gamma,
                                               args.gae_lambda)
 
-        # §2.5 step 4: E epochs of M minibatches over the flattened (time-major) batch.
-        b_obs = obs.reshape((-1, height, width, channels))
-        b_logprobs, b_actions = logprobs.reshape(-1), actions.reshape(-1)
-        b_advantages, b_returns, b_values = advantages.reshape(-1), returns.reshape(-1), values.reshape(-1)
+        # §2.5 step 4: E epochs of M minibatches over each run's flattened (time-major) batch.
+        b_obs = obs.transpose(0, 1).reshape(K, T * N, height, width, channels)
+        b_logprobs, b_actions, b_advantages, b_returns, b_values = (
+            t.transpose(0, 1).reshape(K, T * N) for t in (logprobs, actions, advantages, returns, values))
+        runs_axis = torch.arange(K, device=device)[:, None]
         for epoch in range(args.update_epochs):
             ent_coef = entropy_coefficient(args, optimizer_steps)
-            permutation = torch.randperm(args.batch_size, generator=rng, device=device)
+            counter.fill_((iteration - 1) * args.update_epochs + epoch)
+            permutation = random.permutation(SHUFFLE_STREAM, counter, args.batch_size)  # [K, B]
             for start in range(0, args.batch_size, args.minibatch_size):
-                mb = permutation[start:start + args.minibatch_size]
-                logits, new_value = agent.get_logits_and_value(b_obs[mb])
-                new_logprob = torch.log_softmax(logits, 1).gather(1, b_actions[mb, None]).squeeze(1)
-                loss, pg_loss, v_loss, entropy, approx_kl, clipfrac = ppo_loss(
-                    new_logprob, entropy_of(logits), new_value, b_logprobs[mb], b_values[mb], b_advantages[mb],
-                    b_returns[mb], args, ent_coef)
-                optimizer.zero_grad()
-                loss.backward()
-                nn.utils.clip_grad_norm_(agent.parameters(), args.max_grad_norm)
-                optimizer.step()
+                mb = permutation[:, start:start + args.minibatch_size]
+                with timer("update_forward"):
+                    with autocast(args):
+                        logits, new_value = policy(b_obs[runs_axis, mb])
+                    logits, new_value = logits.float(), new_value.float()
+                    new_logprob = torch.log_softmax(logits, -1).gather(-1, b_actions[runs_axis, mb, None]).squeeze(-1)
+                    loss, pg_loss, v_loss, entropy, approx_kl, clipfrac = ppo_loss(
+                        new_logprob, entropy_of(logits), new_value, b_logprobs[runs_axis, mb], b_values[runs_axis, mb],
+                        b_advantages[runs_axis, mb], b_returns[runs_axis, mb], args, ent_coef)
+                with timer("backward"):
+                    optimizer.zero_grad()
+                    loss.sum().backward()  # the runs' losses are independent: each gradient is its run's own
+                with timer("optimizer"):
+                    clip_grad_norm_per_run(agent, args.max_grad_norm)
+                    optimizer.step()
                 optimizer_steps += 1
 
         # §2.5 step 5, §4.3: losses of the last minibatch; the host reads the scalars once.
-        var_returns = b_returns.var(unbiased=False)
-        explained_var = 1 - (b_returns - b_values).var(unbiased=False) / (var_returns + 1e-8)
+        var_returns = b_returns.var(1, unbiased=False)
+        explained_var = 1 - (b_returns - b_values).var(1, unbiased=False) / (var_returns + 1e-8)
         stored = last_return != 0
-        scalars = torch.cat([torch.stack([v_loss, pg_loss, entropy, approx_kl, clipfrac, loss, explained_var,
-                                          var_returns, torch.where(stored, last_return, 0).sum() / stored.sum().clamp(min=1),
-                                          torch.where(stored, last_length, 0).sum() / stored.sum().clamp(min=1),
-                                          any_finished.float()]), episode_sums]).tolist()
-        sums = scalars[11:]
+        count = stored.sum(1).clamp(min=1)
+        scalars = torch.cat([torch.stack([v_loss, pg_loss, entropy, approx_kl, clipfrac, loss, explained_var, var_returns,
+                                          torch.where(stored, last_return, 0).sum(1) / count,
+                                          torch.where(stored, last_length, 0).sum(1) / count,
+                                          any_finished.float()], 1), episode_sums], 1).tolist()
+        timer.end_iteration()
         iteration_seconds = time.perf_counter() - iteration_start
         train_seconds += iteration_seconds
-        row = {"kind": "train", "iteration": iteration, "global_step": global_step,
-               "charts/learning_rate": optimizer.param_groups[0]["lr"], "charts/entropy_coef": ent_coef,
-               "charts/SPS": global_step / train_seconds, "charts/SPS_update": args.batch_size / iteration_seconds,
-               "losses/value_loss": scalars[0], "losses/policy_loss": scalars[1], "losses/entropy": scalars[2],
-               "losses/approx_kl": scalars[3], "losses/clipfrac": scalars[4], "losses/loss": scalars[5]}
-        if scalars[7] > 0:
-            row["train/explained_variance"] = scalars[6]
-        if scalars[10]:
-            row["train/avg_completed_episodic_return"] = scalars[8]
-            row["train/avg_completed_episodic_length"] = scalars[9]
-        if sums[0] > 0:
-            row.update({f"train/avg_{m}": s / sums[0] for m, s in zip(METRICS, sums[1:])})
-        run.log(row)
-
-        evaluated = False
-        if eval_envs and iteration % args.run_eval_every == 0:  # §2.5 step 6
-            history.append(run.log(evaluation_point(agent, eval_envs, args, iteration, global_step, specs)))
-            evaluated = True
-        if iteration == args.num_iterations and eval_envs and not evaluated:  # §3.1: the final point
-            history.append(run.log(evaluation_point(agent, eval_envs, args, iteration, global_step, specs)))
+        evaluate_now = runs[0].eval_envs and (iteration % args.run_eval_every == 0 or iteration == args.num_iterations)
+        eval_rows = []
+        if evaluate_now:  # §2.5 step 6, and §3.1's final point
+            with timer("eval"):
+                eval_rows = evaluation_rows(agent, runs, args, iteration, global_step)
+        for k, run in enumerate(runs):
+            run.dir.log(train_row(scalars[k], iteration, global_step, train_seconds, iteration_seconds, args,
+                                  optimizer.param_groups[0]["lr"], ent_coef))
+            if eval_rows:
+                run.history.append(run.dir.log(eval_rows[k]))
         if (args.save_checkpoint_every > 0 and iteration % args.save_checkpoint_every == 0) or \
                 iteration == args.num_iterations:  # §2.5 step 7, and at the end
-            save_checkpoint(iteration)
-        progress.update(iteration, global_step, row, history[-1] if evaluated else None)
+            save_checkpoints(iteration)
+        progress.update(iteration, global_step * K, {"charts/SPS": global_step * K / train_seconds},
+                        eval_rows[0] if eval_rows else None)
 
-    run.finish(history)
-    for e in [env, *eval_envs.values()]:
-        e.close()
-    print(f"kage.train: done, {run.path}/summary.json", file=sys.stderr)
+    if last_iteration == args.num_iterations:
+        for run in runs:
+            run.dir.finish(run.history)
+            print(f"kage.train: done, {run.dir.path}/summary.json", file=sys.stderr)
+    for run in runs:
+        for env in [run.env, *run.eval_envs.values()]:
+            env.close()
+    return runs
+
+
+class RolloutPolicy:
+    """The rollout's policy step: forward, Gumbel-max sampling from the action stream (§1.4, §2.4), the
+    log-probability and the value. Under --cuda-graph it is captured once and replayed each step from
+    static input buffers (the random counter is one of them)."""
+
+    def __init__(self, policy, random: CounterRandom, args: Args, obs_shape, device):
+        self.policy, self.random, self.args = policy, random, args
+        self.graph = None
+        self.counter = torch.zeros((), dtype=torch.int64, device=device)
+        if args.cuda_graph:
+            self.obs = torch.zeros(obs_shape, dtype=torch.uint8, device=device)
+            side = torch.cuda.Stream()
+            side.wait_stream(torch.cuda.current_stream())
+            with torch.cuda.stream(side), torch.no_grad():
+                for _ in range(3):  # warm-up: cuDNN picks its algorithms outside the capture
+                    self._step()
+            torch.cuda.current_stream().wait_stream(side)
+            self.graph = torch.cuda.CUDAGraph()
+            with torch.cuda.graph(self.graph), torch.no_grad():
+                self.outputs = self._step()
+
+    def _step(self):
+        with autocast(self.args):
+            logits, value = self.policy(self.obs)
+        logits = logits.float()
+        uniform = self.random.uniform(ACTION_STREAM, self.counter, (logits.shape[1], 8))
+        action, logprob = sample_gumbel_max(logits, uniform)
+        return action, logprob, value.float()
+
+    @torch.no_grad()
+    def __call__(self, obs: torch.Tensor, counter: int):
+        if self.graph is None:
+            self.obs = obs
+            self.counter.fill_(counter)
+            return self._step()
+        self.obs.copy_(obs)
+        self.counter.fill_(counter)
+        self.graph.replay()
+        return self.outputs
+
+
+def train_row(s: List[float], iteration: int, global_step: int, train_seconds: float, iteration_seconds: float,
+              args: Args, learning_rate: float, ent_coef: float) -> dict:
+    """A run's training log row (§4.3) from its scalars: losses, explained variance and its denominator,
+    the stored return and length, whether any episode finished, then the episode count and metric sums."""
+    row = {"kind": "train", "iteration": iteration, "global_step": global_step,
+           "charts/learning_rate": learning_rate, "charts/entropy_coef": ent_coef,
+           "charts/SPS": global_step / train_seconds, "charts/SPS_update": args.batch_size / iteration_seconds,
+           "losses/value_loss": s[0], "losses/policy_loss": s[1], "losses/entropy": s[2],
+           "losses/approx_kl": s[3], "losses/clipfrac": s[4], "losses/loss": s[5]}
+    if s[7] > 0:
+        row["train/explained_variance"] = s[6]
+    if s[10]:
+        row["train/avg_completed_episodic_return"], row["train/avg_completed_episodic_length"] = s[8], s[9]
+    if s[11] > 0:
+        row.update({f"train/avg_{m}": total / s[11] for m, total in zip(METRICS, s[12:])})
+    return row
+
+
+def optimizer_run_state(optimizer: torch.optim.Adam, agent: Agent, run: int) -> dict:
+    """Run `run`'s Adam moments (in its parameters' shapes) and the shared step count."""
+    state = {}
+    for name, p in agent.named_parameters():
+        s = optimizer.state.get(p, {})
+        state[name] = {k: (agent.run_view(v)[run].cpu().clone() if k != "step" else
+                           v.cpu().clone() if torch.is_tensor(v) else v) for k, v in s.items()}
+    return state
+
+
+def load_optimizer(optimizer: torch.optim.Adam, agent: Agent, runs: List[dict]) -> None:
+    """Rebuilds the pack's Adam state from each run's saved part."""
+    for name, p in agent.named_parameters():
+        if not runs[0][name]:
+            continue
+        state = {}
+        for key, value in runs[0][name].items():
+            if key == "step":
+                state[key] = value.clone() if torch.is_tensor(value) else value
+            else:
+                state[key] = torch.empty_like(p).copy_(torch.cat([r[name][key] for r in runs]).to(p.device))
+        optimizer.state[p] = state
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    parsed = parse_args(argv)
+    pack = parsed if isinstance(parsed, list) else [parsed]
+    unfinished = []
+    for args in pack:
+        run_dir = rundir.RunDir.open(args, labels=eval_labels(args))
+        if run_dir.finished:
+            print(f"kage.train: {run_dir.path} is finished (summary.json); nothing to do", file=sys.stderr)
+        else:
+            unfinished.append(args)
+    if unfinished:
+        train(unfinished)
     return 0
 
 

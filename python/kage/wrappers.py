@@ -8,14 +8,18 @@ class FrameStack:
     wherever an episode ended (§1.1)."""
 
     def __init__(self, frame: torch.Tensor, frames: int = 4):
+        """`frame`: [..., H, W, C] uint8."""
         self.frames = frames
-        self.stack = frame.repeat(1, 1, 1, frames).contiguous()
+        self.stack = self._refill(frame)
+
+    def _refill(self, frame: torch.Tensor) -> torch.Tensor:
+        return frame.repeat(*[1] * (frame.dim() - 1), self.frames)
 
     def push(self, frame: torch.Tensor, done: torch.Tensor) -> torch.Tensor:
+        """Appends `frame`; `done` ([...], 0/1) marks the environments whose episode just ended."""
         c = frame.shape[-1]
         self.stack = torch.cat([self.stack[..., c:], frame], dim=-1)
-        refill = frame.repeat(1, 1, 1, self.frames)
-        self.stack = torch.where(done.bool()[:, None, None, None], refill, self.stack)
+        self.stack = torch.where(done.bool()[..., None, None, None], self._refill(frame), self.stack)
         return self.stack
 
 
@@ -23,12 +27,13 @@ class RewardNormalizer:
     """Per-environment running return statistics, as RewardNormalizeWrapper(gamma=0.999) (§2.2, kage-env
     10.4): ret = ret * gamma * (1 - done) + r, Welford-style mean/var, emits r / (sqrt(var) + 1e-8)."""
 
-    def __init__(self, num_envs: int, gamma: float, device):
+    def __init__(self, shape, gamma: float, device):
+        """`shape`: the reward's, one statistic per environment."""
         self.gamma = gamma
-        self.ret = torch.zeros(num_envs, device=device)
-        self.mean = torch.zeros(num_envs, device=device)
-        self.var = torch.ones(num_envs, device=device)
-        self.count = torch.full((num_envs,), 1e-4, device=device)
+        self.ret = torch.zeros(shape, device=device)
+        self.mean = torch.zeros(shape, device=device)
+        self.var = torch.ones(shape, device=device)
+        self.count = torch.full(shape, 1e-4, device=device)
 
     def __call__(self, reward: torch.Tensor, done: torch.Tensor) -> torch.Tensor:
         self.ret = self.ret * self.gamma * (1 - done) + reward

@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 import torch
 
-from kage.train import (METRICS, Agent, Args, EpisodeMetrics, compute_gae, entropy_of, ppo_loss, sample_gumbel_max,
-                        summarize_evaluation)
+from kage.counter_random import CounterRandom
+from kage.train import (METRICS, Agent, Args, EpisodeMetrics, clip_grad_norm_per_run, compute_gae, entropy_of,
+                        ppo_loss, sample_gumbel_max, summarize_evaluation)
 
 
 def test_gae_on_a_three_step_batch():
@@ -62,29 +63,60 @@ def test_entropy_of_uniform_and_of_a_certain_policy():
 
 def test_gumbel_max_sampling_reports_its_log_probability():
     logits = torch.log(torch.tensor([[0.7, 0.1, 0.1, 0.1, 0, 0, 0, 0]]) + 1e-12).repeat(4000, 1)
-    action, logprob = sample_gumbel_max(logits, torch.Generator().manual_seed(0))
+    uniform = CounterRandom([0], "cpu").uniform(1, torch.tensor(0), (4000, 8))[0]
+    action, logprob = sample_gumbel_max(logits, uniform)
     freq = torch.bincount(action, minlength=8).float() / 4000
     assert freq[0].item() == pytest.approx(0.7, abs=0.03) and freq[4:].sum().item() == 0
     assert torch.allclose(logprob, torch.log_softmax(logits, 1).gather(1, action[:, None]).squeeze(1))
 
 
 def test_network_matches_the_specification():
-    agent = Agent()
+    agent = Agent([1])
     assert sum(p.numel() for p in agent.parameters()) == 4_799_657
-    assert sum(p.numel() for p in Agent(channels=12).parameters()) == 4_818_089
-    x = torch.zeros(2, 128, 128, 3, dtype=torch.uint8)
+    assert sum(p.numel() for p in Agent([1], channels=12).parameters()) == 4_818_089
+    h = torch.zeros(2, 3, 128, 128)
     shapes = []
-    h = x.permute(0, 3, 1, 2).float()
-    for layer in agent.network:
-        h = layer(h)
+    for conv in (agent.conv1, agent.conv2, agent.conv3):
+        h = conv(h)
         shapes.append(tuple(h.shape[1:]))
-    assert shapes[1] == (32, 31, 31) and shapes[3] == (64, 14, 14) and shapes[5] == (64, 12, 12)
-    assert shapes[6] == (9216,) and shapes[8] == (512,)
-    # Orthogonal rows scaled by the gain: actor 0.01, critic 1; biases 0.
-    actor = agent.actor.weight
-    assert torch.allclose(actor @ actor.T, 0.01 ** 2 * torch.eye(8), atol=1e-8)
-    assert agent.critic.weight.norm().item() == pytest.approx(1.0, rel=1e-5)
-    assert all(float(m.bias.abs().max()) == 0 for m in agent.modules() if hasattr(m, "bias") and m.bias is not None)
+    assert shapes == [(32, 31, 31), (64, 14, 14), (64, 12, 12)] and agent.flat == 9216
+    assert agent.fc_weight.shape == (1, 9216, 512)
+    logits, value = agent(torch.zeros(1, 5, 128, 128, 3, dtype=torch.uint8))
+    assert logits.shape == (1, 5, 8) and value.shape == (1, 5)
+    # Orthogonal columns scaled by the gain: actor 0.01, critic 1; orthogonal conv filters (gain sqrt 2).
+    actor = agent.actor_weight[0]
+    assert torch.allclose(actor.T @ actor, 0.01 ** 2 * torch.eye(8), atol=1e-8)
+    assert agent.critic_weight.norm().item() == pytest.approx(1.0, rel=1e-5)
+    filters = agent.conv2.weight.reshape(64, -1)
+    assert torch.allclose(filters @ filters.T, 2 * torch.eye(64), atol=1e-4)
+    biases = [agent.conv1.bias, agent.conv2.bias, agent.conv3.bias, agent.fc_bias, agent.actor_bias, agent.critic_bias]
+    assert all(float(b.abs().max()) == 0 for b in biases)
+
+
+def test_a_packed_agent_holds_each_lone_agent():
+    # 44 x 44 frames (a 2 x 2 x 64 torso output) keep the orthogonal initialisations fast.
+    lone = [Agent([seed], height=44, width=44) for seed in (4, 9, 2)]
+    packed = Agent([4, 9, 2], height=44, width=44)
+    obs = torch.randint(0, 256, (3, 6, 44, 44, 3), dtype=torch.uint8)
+    logits, value = packed(obs)
+    for k, agent in enumerate(lone):
+        packed_params = dict(packed.named_parameters())
+        for name, p in agent.named_parameters():
+            assert torch.equal(packed.run_view(packed_params[name])[k], agent.run_view(p)[0]), name
+        l, v = agent(obs[k:k + 1])
+        assert torch.allclose(logits[k], l[0], atol=1e-5) and torch.allclose(value[k], v[0], atol=1e-5)
+
+
+def test_gradient_clipping_is_per_run():
+    agent = Agent([1, 2], height=44, width=44)
+    for p in agent.parameters():
+        p.grad = torch.zeros_like(p)
+    agent.fc_bias.grad[0].fill_(1.0)    # run 0: norm sqrt(512) > 0.5 -> scaled to 0.5
+    agent.actor_bias.grad[1].fill_(0.1)  # run 1: norm sqrt(8) * 0.1 < 0.5 -> unchanged
+    norms = clip_grad_norm_per_run(agent, 0.5)
+    assert norms.tolist() == pytest.approx([math.sqrt(512), math.sqrt(8) * 0.1])
+    assert agent.fc_bias.grad[0].norm().item() == pytest.approx(0.5)
+    assert torch.allclose(agent.actor_bias.grad[1], torch.full((1, 8), 0.1))
 
 
 def test_evaluation_summary_follows_the_protocol():
@@ -114,6 +146,6 @@ def test_success_is_strict_at_the_terminal_state():
                    "success": np.ones(n, dtype=np.uint8), "success_once": np.array([1, 1, 0], dtype=np.uint8),
                    "passed_distance": np.array([490.0, 491.0, 12.0], dtype=np.float32)})
     info = {"_final": np.array([1, 1, 1], dtype=np.uint8), "final_info": fields}
-    rows = EpisodeMetrics(None, info, 490.0).rows()
+    rows = EpisodeMetrics([info], [490.0], "cpu").rows()[0]
     assert rows[3 + METRICS.index("success")].tolist() == [0.0, 1.0, 0.0]  # 490 > 490 is false (QUIRK)
     assert rows[3 + METRICS.index("success_once")].tolist() == [1.0, 1.0, 0.0]
