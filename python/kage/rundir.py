@@ -131,9 +131,12 @@ class RunDir:
     # ---- checkpoints ----
 
     def save_checkpoint(self, state: dict) -> None:
+        """checkpoints/latest.pt, and latest.json naming its iteration (read by kage.bench to pack runs
+        that resume from the same iteration without loading the checkpoints)."""
         buffer = io.BytesIO()
         torch.save(state, buffer)
         atomic_write(os.path.join(self.path, "checkpoints", "latest.pt"), buffer.getvalue())
+        write_json(os.path.join(self.path, "checkpoints", "latest.json"), {"iteration": state["iteration"]})
 
     def load_checkpoint(self, device) -> Optional[dict]:
         """The latest checkpoint (and the log cut back to it), or None for a fresh run (the log emptied)."""

@@ -213,6 +213,7 @@ class Agent(nn.Module):
         self.actor_bias = nn.Parameter(torch.zeros(k, 1, 8, device=device))
         self.critic_weight = nn.Parameter(torch.empty(k, 512, 1, device=device))
         self.critic_bias = nn.Parameter(torch.zeros(k, 1, 1, device=device))
+        self.input_dtype = torch.float32  # bfloat16 under --bf16
         with torch.no_grad():
             for run, seed in enumerate(seeds):
                 self._initialise(run, seed, channels)
@@ -235,9 +236,11 @@ class Agent(nn.Module):
         conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups."""
         k, b, h, w, c = obs.shape
         frames = obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c).permute(0, 3, 1, 2)  # channels last
-        x = frames.float() / 255.0
         if not self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
-            x = x.contiguous()
+            frames = frames.contiguous()
+        # Under --bf16 the conversion goes straight to bfloat16: uint8 values are exact there, and x / 255
+        # rounds to the bfloat16 that autocast would make of the float32 quotient (one pass, half the bytes).
+        x = frames.to(self.input_dtype).div_(255.0)
         x = F.relu(self.conv1(x))
         x = F.relu(self.conv2(x))
         x = F.relu(self.conv3(x))
@@ -521,6 +524,8 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
     agent = Agent([a.seed for a in pack], channels, height, width, device)  # §2.4: the runs' seeds
     if args.channels_last:
         agent = agent.to(memory_format=torch.channels_last)
+    if args.bf16:
+        agent.input_dtype = torch.bfloat16
     policy = torch.compile(agent) if args.compile else agent
     optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5)
     random = CounterRandom([a.seed for a in pack], device)
@@ -622,7 +627,10 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
                 if args.bootstrap_truncation:
                     with torch.no_grad(), autocast(args):  # the value of the observation the truncation discarded
                         truncated = torch.stack(env_truncated).float() * finished
-                        reward = reward + args.gamma * policy(torch.stack(final_frames))[1].float() * truncated
+                        final = torch.stack(final_frames)
+                        if stack:  # the final frame on top of the episode's last stack
+                            final = torch.cat([stack.stack[..., final.shape[-1]:], final], -1)
+                        reward = reward + args.gamma * policy(final)[1].float() * truncated
                 if normalizer:
                     reward = normalizer(reward, next_done)
                 rewards[step] = reward.clamp(args.reward_clip_min, args.reward_clip_max)
@@ -680,7 +688,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
         timer.end_iteration()
         iteration_seconds = time.perf_counter() - iteration_start
         train_seconds += iteration_seconds
-        evaluate_now = runs[0].eval_envs and (iteration % args.run_eval_every == 0 or iteration == args.num_iterations)
+        evaluate_now = runs[0].eval_envs and (iteration % args.run_eval_every == 0 or iteration == last_iteration)
         eval_rows = []
         if evaluate_now:  # §2.5 step 6, and §3.1's final point
             with timer("eval"):

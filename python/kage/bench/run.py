@@ -1,11 +1,13 @@
 """python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [trainer flags]
 
-Trains every (pair, seed) of a suite manifest with `python3 -m kage.train`, one run after the other, each
-in its own process and run directory:
+Trains every (pair, seed) of a suite manifest with `python3 -m kage.train`, each run in its own run
+directory, one process after the other; --pack K trains K runs at once in one process (one GPU), which
+the learner's batched forward and backward make several times faster in aggregate:
 
     DIR/suite.json                  the suite's report (kagec suite): pairs, axes, paths, spec hashes, certificates
     DIR/bench.json                  the manifest, the seeds asked for so far and the trainer flags
     DIR/runs/<pair>/seed_<s>/       a training run (kage.train's run directory) and its train.log
+    DIR/packs/pack_<i>.json, .log   under --pack: the runs one process trained together, and its log
 
 A plain pair trains on its train config and evaluates on its eval config (label "eval"). A sweep (one
 train config, several evals) runs once per seed and evaluates every eval config of the sweep (labels:
@@ -26,7 +28,7 @@ from typing import Dict, List, Optional
 
 from kage import _kage
 from kage.errors import ConfigError
-from kage.files import write_json
+from kage.files import atomic_write, write_json
 
 
 @dataclasses.dataclass
@@ -117,11 +119,38 @@ def record_bench(out: str, manifest: str, seeds: List[int], units: List[str], tr
     write_json(path, {"kage_bench": 1, "suite": manifest, "seeds": seeds, "units": units, "trainer_args": trainer_args})
 
 
-def train_command(unit: Unit, seed: int, run_dir: str, trainer_args: List[str]) -> List[str]:
+def train_flags(unit: Unit, seed: int, run_dir: str, trainer_args: List[str]) -> List[str]:
     evals = ["--eval-config-path", unit.evals[0]] if len(unit.evals) == 1 else ["--eval-config-paths", *unit.evals]
-    return [sys.executable, "-m", "kage.train", "--train-config-path", unit.train, *evals,
-            "--eval-config-labels", *unit.labels, "--seed", str(seed), "--out", run_dir,
-            "--exp-name", unit.name.replace("/", "_"), *trainer_args]
+    return ["--train-config-path", unit.train, *evals, "--eval-config-labels", *unit.labels, "--seed", str(seed),
+            "--out", run_dir, "--exp-name", unit.name.replace("/", "_"), *trainer_args]
+
+
+def checkpoint_iteration(run_dir: str) -> int:
+    """The iteration of a run's last checkpoint (0 for none)."""
+    try:
+        with open(os.path.join(run_dir, "checkpoints", "latest.json")) as f:
+            return json.load(f)["iteration"]
+    except (OSError, ValueError, KeyError):
+        return 0
+
+
+def packs_of(jobs: List[tuple], size: int) -> List[List[tuple]]:
+    """Jobs (unit, seed, run_dir) in packs of at most `size`: a pack's runs evaluate the same number of
+    configs and resume from the same iteration (they step in lockstep)."""
+    groups: Dict[tuple, List[tuple]] = {}
+    for job in jobs:
+        groups.setdefault((len(job[0].evals), checkpoint_iteration(job[2])), []).append(job)
+    return [group[i:i + size] for group in groups.values() for i in range(0, len(group), size)]
+
+
+def write_pack_file(out: str, index: int, pack: List[tuple], trainer_args: List[str]) -> str:
+    """DIR/packs/pack_<index>.json: the pack's runs as kage.train arguments (python3 -m kage.train --pack)."""
+    from kage import train
+    runs = [dataclasses.asdict(train.parse_args(train_flags(u, s, d, trainer_args))) for u, s, d in pack]
+    path = os.path.join(out, "packs", f"pack_{index}.json")
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    atomic_write(path, json.dumps({"runs": runs}, indent=1).encode())  # infinities as Infinity: read by Python
+    return path
 
 
 class Display:
@@ -134,10 +163,11 @@ class Display:
         self.live = sys.stderr.isatty()
         self.rate: Optional[float] = None
 
-    def running(self, label: str, metrics_path: str) -> None:
+    def running(self, label: str, metrics_path: str, runs: int) -> None:
+        """`runs` runs in one process, `metrics_path` the log of one of them."""
         step, rate = last_progress(metrics_path)
-        self.rate = rate or self.rate
-        remaining = (self.total - self.done) * self.steps_per_run - step
+        self.rate = rate * runs if rate else self.rate
+        remaining = (self.total - self.done) * self.steps_per_run - step * runs
         eta = f"ETA {remaining / self.rate / 60:,.0f} min" if self.rate else "ETA -"
         speed = f"{self.rate:,.0f} steps/s" if self.rate else "- steps/s"
         if self.live:
@@ -175,7 +205,10 @@ def main(argv: List[str]) -> int:
     parser.add_argument("--seeds", default="1-10", help="seeds: 1-10 (default), 1,3,5 or 7")
     parser.add_argument("--out", required=True, help="the benchmark directory (created, or continued)")
     parser.add_argument("--pairs", nargs="+", help="only these pairs or sweeps (by name)")
+    parser.add_argument("--pack", type=int, default=1, help="train K runs at once in one process (default 1)")
     args, trainer_args = parser.parse_known_args(argv)
+    if args.pack < 1:
+        raise SystemExit(f"kage.bench run: --pack {args.pack}: a positive number of runs per process")
     for flag in ("--train-config-path", "--eval-config-path", "--eval-config-paths", "--eval-config-labels",
                  "--seed", "--out", "--exp-name"):
         if flag in trainer_args:
@@ -197,26 +230,36 @@ def main(argv: List[str]) -> int:
     record_bench(args.out, args.suite, seeds, [u.name for u in units], trainer_args)
     write_json(os.path.join(args.out, "suite.json"), report)
 
-    jobs = [(u, s) for u in units for s in seeds]
+    jobs = [(u, s, os.path.join(args.out, "runs", u.name, f"seed_{s}")) for u in units for s in seeds]
     display = Display(len(jobs), probe.num_iterations * probe.batch_size)
-    failures = []
-    for unit, seed in jobs:
-        label = f"{unit.name} seed {seed}"
-        run_dir = os.path.join(args.out, "runs", unit.name, f"seed_{seed}")
+    pending = []
+    for unit, seed, run_dir in jobs:
         if os.path.exists(os.path.join(run_dir, "summary.json")):
-            display.finished(label, "finished earlier, skipped")
-            continue
-        os.makedirs(run_dir, exist_ok=True)
-        with open(os.path.join(run_dir, "train.log"), "ab") as log:
-            child = subprocess.Popen(train_command(unit, seed, run_dir, trainer_args), stdout=log, stderr=log)
-            while child.poll() is None:
-                display.running(label, os.path.join(run_dir, "metrics.jsonl"))
-                time.sleep(1.0)
-        if child.returncode == 0:
-            display.finished(label, "done")
+            display.finished(f"{unit.name} seed {seed}", "finished earlier, skipped")
         else:
-            failures.append(label)
-            display.finished(label, f"FAILED (exit {child.returncode}); see {run_dir}/train.log")
+            os.makedirs(run_dir, exist_ok=True)
+            pending.append((unit, seed, run_dir))
+    failures = []
+    for index, pack in enumerate(packs_of(pending, args.pack)):
+        labels = [f"{u.name} seed {s}" for u, s, _ in pack]
+        if len(pack) == 1:
+            log_path = os.path.join(pack[0][2], "train.log")
+            command = train_flags(*pack[0], trainer_args)
+        else:
+            log_path = os.path.join(args.out, "packs", f"pack_{index}.log")
+            command = ["--pack", write_pack_file(args.out, index, pack, trainer_args)]
+        label = labels[0] if len(pack) == 1 else f"pack of {len(pack)} ({labels[0]}, ...)"
+        with open(log_path, "ab") as log:
+            child = subprocess.Popen([sys.executable, "-m", "kage.train", *command], stdout=log, stderr=log)
+            while child.poll() is None:
+                display.running(label, os.path.join(pack[0][2], "metrics.jsonl"), len(pack))
+                time.sleep(1.0)
+        for one in labels:
+            if child.returncode == 0:
+                display.finished(one, "done")
+            else:
+                failures.append(one)
+                display.finished(one, f"FAILED (exit {child.returncode}); see {log_path}")
     if failures:
         print(f"kage.bench run: {len(failures)} run(s) failed: {', '.join(failures)}; rerun to resume them",
               file=sys.stderr)

@@ -1,0 +1,45 @@
+"""The trainer's optional behaviours run end to end on the CPU: frame stacking, reward normalisation,
+bootstrapping at truncation, the annealings, channels-last convolutions, greedy evaluation, several eval
+configs; and flags it cannot honour are refused with the fix."""
+import json
+
+import pytest
+
+from kage import train
+from support import CONFIGS, NEAR_GOAL
+
+OPTIONS = ["--use-frame-stack", "--normalize-reward", "--bootstrap-truncation", "--anneal-lr", "--ent-coef-anneal",
+           "--channels-last", "--eval-greedy"]
+
+
+def test_every_option_at_once(tmp_path):
+    out = tmp_path / "run"
+    args = train.parse_args([
+        "--train-config-path", NEAR_GOAL, "--eval-config-paths", str(CONFIGS / "near_goal_red.yaml"),
+        str(CONFIGS / "noisy_short.yaml"), "--eval-config-labels", "red", "noisy", "--seed", "2", "--device", "cpu",
+        "--threads", "1", "--total-timesteps", "192", "--num-envs", "2", "--num-steps", "16", "--num-minibatches", "2",
+        "--update-epochs", "1", "--run-eval-every", "3", "--eval-episodes", "2", "--eval-num-envs", "2",
+        "--out", str(out), *OPTIONS])
+    train.train([args])
+    rows = [json.loads(line) for line in open(out / "metrics.jsonl")]
+    train_rows = [r for r in rows if r["kind"] == "train"]
+    assert [r["iteration"] for r in train_rows] == list(range(1, 7))
+    lrs = [r["charts/learning_rate"] for r in train_rows]
+    assert lrs[0] == 5e-4 and lrs == sorted(lrs, reverse=True) and lrs[-1] > 0
+    assert train_rows[-1]["charts/entropy_coef"] < 0.01
+    evals = [r for r in rows if r["kind"] == "eval"]
+    assert [e["iteration"] for e in evals] == [0, 3, 6] and set(evals[-1]["evals"]) == {"red", "noisy"}
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["evaluations"] == 3 and "diff/noisy/success_once" in summary["stats"]
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--device", "cpu", "--bf16"], "--bf16 and --cuda-graph are for --device cuda"),
+    (["--num-minibatches", "3"], "must divide the batch"),
+    (["--eval-config-paths", "a", "b", "--eval-config-labels", "x"], "gives 1 labels for 2 eval configs"),
+    (["--total-timesteps", "10"], "less than one batch"),
+])
+def test_flags_it_cannot_honour(flags, message, capsys):
+    with pytest.raises(SystemExit):
+        train.parse_args(["--train-config-path", NEAR_GOAL, *flags])
+    assert message in capsys.readouterr().err
