@@ -97,6 +97,8 @@ class Args:
     bf16: bool = field(default=False, metadata={"help": "bfloat16 autocast for the network (GPU)"})
     channels_last: bool = field(default=False, metadata={"help": "channels-last convolutions"})
     cuda_graph: bool = field(default=False, metadata={"help": "replay the rollout's policy step as a CUDA graph"})
+    fused_input: bool = field(default=False, metadata={
+        "help": "one pass from uint8 frames to 4x4 blocks in the network's dtype; conv1 as the equal 2x2 conv"})
     compile: bool = field(default=False, metadata={"help": "torch.compile the network (torch 2.x)"})
 
     @property
@@ -214,6 +216,7 @@ class Agent(nn.Module):
         self.critic_weight = nn.Parameter(torch.empty(k, 512, 1, device=device))
         self.critic_bias = nn.Parameter(torch.zeros(k, 1, 1, device=device))
         self.input_dtype = torch.float32  # bfloat16 under --bf16
+        self.space_to_depth = False  # --fused-input
         with torch.no_grad():
             for run, seed in enumerate(seeds):
                 self._initialise(run, seed, channels)
@@ -235,13 +238,10 @@ class Agent(nn.Module):
         """uint8 [K, B, H, W, C] frames -> logits [K, B, 8] and values [K, B]. The first operation is the
         conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups."""
         k, b, h, w, c = obs.shape
-        frames = obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c).permute(0, 3, 1, 2)  # channels last
-        if not self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
-            frames = frames.contiguous()
-        # Under --bf16 the conversion goes straight to bfloat16: uint8 values are exact there, and x / 255
-        # rounds to the bfloat16 that autocast would make of the float32 quotient (one pass, half the bytes).
-        x = frames.to(self.input_dtype).div_(255.0)
-        x = F.relu(self.conv1(x))
+        if self.space_to_depth:
+            x = F.relu(self._conv1_space_to_depth(obs))
+        else:
+            x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
         x = F.relu(self.conv2(x))
         x = F.relu(self.conv3(x))
         x = x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
@@ -249,6 +249,31 @@ class Agent(nn.Module):
         logits = torch.baddbmm(self.actor_bias, hidden, self.actor_weight)
         value = torch.baddbmm(self.critic_bias, hidden, self.critic_weight).squeeze(-1)
         return logits, value
+
+    def _input(self, frames: torch.Tensor) -> torch.Tensor:
+        """uint8 [B, H, W, C'] -> [B, C', H, W] / 255 in the input dtype, channels last when the weights are.
+        Under --bf16 the conversion goes straight to bfloat16: uint8 values are exact there, and x / 255
+        rounds to the bfloat16 that autocast would make of the float32 quotient (one pass, half the bytes)."""
+        x = frames.permute(0, 3, 1, 2)
+        if not self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
+            x = x.contiguous()
+        return x.to(self.input_dtype).div_(255.0)
+
+    def _conv1_space_to_depth(self, obs: torch.Tensor) -> torch.Tensor:
+        """conv1 (8x8, stride 4, C channels) as the equal 2x2, stride-1 convolution of the frames cut into
+        4x4 blocks of 16 C channels: the same products and sums (row 4a + p, column 4b + q of a filter
+        meets channel (c, p, q) at offset (a, b)), but 48 channels a group instead of 3, which the
+        convolution kernels use far better. The rearrangement is the same single copy the frames need
+        anyway (--fused-input)."""
+        k, b, h, w, c = obs.shape
+        h, w = h // 4 * 4, w // 4 * 4  # rows and columns past the last whole block are never read
+        blocks = obs[:, :, :h, :w].reshape(k, b, h // 4, 4, w // 4, 4, c).permute(1, 2, 4, 0, 6, 3, 5)
+        x = self._input(blocks.reshape(b, h // 4, w // 4, k * c * 16))
+        weight = self.conv1.weight  # [K*32, C, 8, 8] = [K*32, C, (a, p), (b, q)]
+        weight = weight.view(-1, c, 2, 4, 2, 4).permute(0, 1, 3, 5, 2, 4).reshape(-1, c * 16, 2, 2)
+        if self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
+            weight = weight.contiguous(memory_format=torch.channels_last)
+        return F.conv2d(x, weight, self.conv1.bias, stride=1, groups=k)
 
     def run_view(self, tensor: torch.Tensor) -> torch.Tensor:
         """A tensor shaped like a parameter (the parameter, its gradient, an Adam moment) as [K, ...]: the
@@ -526,6 +551,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
         agent = agent.to(memory_format=torch.channels_last)
     if args.bf16:
         agent.input_dtype = torch.bfloat16
+    agent.space_to_depth = args.fused_input
     policy = torch.compile(agent) if args.compile else agent
     optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5)
     random = CounterRandom([a.seed for a in pack], device)

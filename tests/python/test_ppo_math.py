@@ -149,3 +149,19 @@ def test_success_is_strict_at_the_terminal_state():
     rows = EpisodeMetrics([info], [490.0], "cpu").rows()[0]
     assert rows[3 + METRICS.index("success")].tolist() == [0.0, 1.0, 0.0]  # 490 > 490 is false (QUIRK)
     assert rows[3 + METRICS.index("success_once")].tolist() == [1.0, 1.0, 0.0]
+
+
+def test_space_to_depth_conv1_equals_the_8x8_convolution():
+    agent = Agent([5, 6], height=44, width=44)
+    obs = torch.randint(0, 256, (2, 3, 44, 44, 3), dtype=torch.uint8)
+    plain = agent(obs)
+    agent.space_to_depth = True
+    blocked = agent(obs)
+    for a, b in zip(plain, blocked):
+        assert torch.allclose(a, b, rtol=1e-5, atol=1e-6)
+    for k in range(2):  # and each run's output is its own 8x8 convolution of its frames
+        x = obs[k].permute(0, 3, 1, 2).float() / 255.0
+        w = agent.run_view(agent.conv1.weight)[k]
+        reference = torch.nn.functional.conv2d(x, w, agent.run_view(agent.conv1.bias)[k], stride=4)
+        got = agent._conv1_space_to_depth(obs)[:, k * 32:(k + 1) * 32]
+        assert torch.allclose(got, reference, rtol=1e-5, atol=1e-5)
