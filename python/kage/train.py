@@ -399,22 +399,22 @@ def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int
     metrics = EpisodeMetrics(infos, [d for run in dists for d in run], device)
     stack = FrameStack(torch.stack(frames)) if args.use_frame_stack else None
     chunk = -(-episodes // n) * episode_length
-    records, step = [], 0
+    records, waves = [], 0
     while True:
-        for _ in range(chunk):
+        noise = random.uniform(0, counter.fill_(waves), (chunk, n, 8))  # each evaluation's draws for the chunk
+        waves += 1
+        for step in range(chunk):
             obs = stack.stack if stack else torch.stack(frames)             # [K * C, E, H, W, ch]
             with autocast(args):
                 logits, _ = agent(obs.view(len(envs), configs * n, *obs.shape[2:]))
             logits = logits.float().view(len(flat_envs), n, 8)
             # QUIRK: sampled, not greedy (Gumbel-max: an exact categorical sampler with no host check).
-            uniform = random.uniform(0, counter.fill_(step), (n, 8))
-            actions = logits.argmax(-1) if args.eval_greedy else sample_gumbel_max(logits, uniform)[0]
+            actions = logits.argmax(-1) if args.eval_greedy else sample_gumbel_max(logits, noise[:, step])[0]
             for env, action in zip(flat_envs, actions):
                 env.step(action)
             if stack:
                 stack.push(torch.stack(frames), metrics.mask())
             records.append(metrics.rows())
-            step += 1
         if torch.stack(records)[:, :, 0].sum((0, 2)).min().item() >= episodes:  # the one host read
             break
     host = torch.stack(records).cpu()
@@ -629,27 +629,44 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
     progress = rundir.Progress(args.num_iterations, args.batch_size * K)
     last_iteration = args.num_iterations if stop_after is None else min(args.num_iterations,
                                                                         start_iteration + stop_after - 1)
-    rollout = RolloutPolicy(policy, random, args, observe().shape, device)
+    rollout = RolloutPolicy(policy, args, observe().shape, device)
+    # Episodes end only by truncation at episode_length (§2.3): when no episode is shorter than a rollout, an
+    # environment ends at most one per rollout, and its final info still holds it when the rollout is over,
+    # so the episode metrics are read once per rollout instead of after every step.
+    read_once = min(r.specs["train"]["config"]["episode_length"] for r in runs) >= T
+    finished_at = torch.zeros((T, K, N), device=device)
+
+    def tally(rows: torch.Tensor, finished: torch.Tensor) -> None:
+        """§4.2: sums of the finished episodes' metrics; each environment's latest return and length."""
+        nonlocal episode_sums, last_return, last_length
+        episode_sums += torch.cat([finished.sum(1, keepdim=True), (rows[:, 3:] * finished[:, None]).sum(2)], 1)
+        last_return = torch.where(finished > 0, rows[:, 1], last_return)
+        last_length = torch.where(finished > 0, rows[:, 2], last_length)
+        any_finished.logical_or_(finished.any(1))
+
     for iteration in range(start_iteration, last_iteration + 1):
         iteration_start = time.perf_counter()
         if args.anneal_lr:  # §2.6
             optimizer.param_groups[0]["lr"] = args.learning_rate * (1.0 - (iteration - 1.0) / args.num_iterations)
         episode_sums = torch.zeros((K, len(METRICS) + 1), device=device)  # count, then the nine metrics
+        # The action stream's draws for the whole rollout; the counter names the iteration, so a run draws the
+        # same numbers alone, packed or resumed.
+        noise = random.uniform(ACTION_STREAM, counter.fill_(iteration - 1), (T, N, 8))
 
         for step in range(T):  # §2.5 step 1
             with timer("forward"):
                 obs[step] = observe()
                 dones[step] = next_done
-                # The counter names this draw (iteration, step): the same numbers alone, packed or resumed.
-                action, logprob, value = rollout(obs[step], (iteration - 1) * T + step)
+                action, logprob, value = rollout(obs[step], noise[:, step])
                 values[step], actions[step], logprobs[step] = value, action, logprob
             with timer("env"):
                 for run, a in zip(runs, action):
                     run.env.step(a)
                 reward = torch.stack(env_reward)
                 next_done = (torch.stack(env_terminated) | torch.stack(env_truncated)).float()  # QUIRK (§2.5 b)
-                rows = episode.rows()
-                finished = rows[:, 0]
+                finished = finished_at[step] = episode.mask()
+                if not read_once:
+                    tally(episode.rows(), finished)
                 if args.bootstrap_truncation:
                     with torch.no_grad(), autocast(args):  # the value of the observation the truncation discarded
                         truncated = torch.stack(env_truncated).float() * finished
@@ -660,13 +677,11 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
                 if normalizer:
                     reward = normalizer(reward, next_done)
                 rewards[step] = reward.clamp(args.reward_clip_min, args.reward_clip_max)
-                # §4.2: sums of the finished episodes' metrics; each environment's latest return and length.
-                episode_sums += torch.cat([finished.sum(1, keepdim=True), (rows[:, 3:] * finished[:, None]).sum(2)], 1)
-                last_return = torch.where(finished > 0, rows[:, 1], last_return)
-                last_length = torch.where(finished > 0, rows[:, 2], last_length)
-                any_finished |= finished.any(1)
                 if stack:
                     stack.push(torch.stack(frames), next_done)
+        if read_once:
+            with timer("env"):
+                tally(episode.rows(), finished_at.sum(0))
         global_step += args.batch_size  # §2.5 step 2
 
         with torch.no_grad(), timer("forward"):  # §2.5 step 3
@@ -741,16 +756,16 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
 
 
 class RolloutPolicy:
-    """The rollout's policy step: forward, Gumbel-max sampling from the action stream (§1.4, §2.4), the
+    """The rollout's policy step: forward, Gumbel-max sampling (§1.4) with the given uniforms, the
     log-probability and the value. Under --cuda-graph it is captured once and replayed each step from
-    static input buffers (the random counter is one of them)."""
+    static input buffers."""
 
-    def __init__(self, policy, random: CounterRandom, args: Args, obs_shape, device):
-        self.policy, self.random, self.args = policy, random, args
+    def __init__(self, policy, args: Args, obs_shape, device):
+        self.policy, self.args = policy, args
         self.graph = None
-        self.counter = torch.zeros((), dtype=torch.int64, device=device)
         if args.cuda_graph:
             self.obs = torch.zeros(obs_shape, dtype=torch.uint8, device=device)
+            self.uniform = torch.full((*obs_shape[:2], 8), 0.5, device=device)
             side = torch.cuda.Stream()
             side.wait_stream(torch.cuda.current_stream())
             with torch.cuda.stream(side), torch.no_grad():
@@ -764,19 +779,17 @@ class RolloutPolicy:
     def _step(self):
         with autocast(self.args):
             logits, value = self.policy(self.obs)
-        logits = logits.float()
-        uniform = self.random.uniform(ACTION_STREAM, self.counter, (logits.shape[1], 8))
-        action, logprob = sample_gumbel_max(logits, uniform)
+        action, logprob = sample_gumbel_max(logits.float(), self.uniform)
         return action, logprob, value.float()
 
     @torch.no_grad()
-    def __call__(self, obs: torch.Tensor, counter: int):
+    def __call__(self, obs: torch.Tensor, uniform: torch.Tensor):
+        """obs [K, N, H, W, C] uint8, uniform [K, N, 8] in (0, 1) -> action, log-probability, value [K, N]."""
         if self.graph is None:
-            self.obs = obs
-            self.counter.fill_(counter)
+            self.obs, self.uniform = obs, uniform
             return self._step()
         self.obs.copy_(obs)
-        self.counter.fill_(counter)
+        self.uniform.copy_(uniform)
         self.graph.replay()
         return self.outputs
 

@@ -43,3 +43,19 @@ def test_flags_it_cannot_honour(flags, message, capsys):
     with pytest.raises(SystemExit):
         train.parse_args(["--train-config-path", NEAR_GOAL, *flags])
     assert message in capsys.readouterr().err
+
+
+def test_episodes_shorter_than_a_rollout_are_all_counted(tmp_path):
+    # 40-step episodes, 64-step rollouts: an environment can end two episodes in one rollout, so the
+    # trainer reads the episode metrics after every step (the benchmark's 500-step episodes are read once).
+    out = tmp_path / "run"
+    train.train([train.parse_args([
+        "--train-config-path", NEAR_GOAL, "--seed", "4", "--device", "cpu", "--threads", "1", "--total-timesteps", "128",
+        "--num-envs", "1", "--num-steps", "64", "--num-minibatches", "2", "--update-epochs", "1",
+        "--run-eval-every", "0", "--out", str(out)])])
+    rows = [json.loads(line) for line in open(out / "metrics.jsonl")]
+    assert [r["iteration"] for r in rows] == [1, 2]
+    # Episodes end at steps 40, 80 and 120: one in the first rollout, two in the second.
+    assert all(r["train/avg_completed_episodic_length"] == 40 for r in rows)
+    assert all("train/avg_passed_distance" in r for r in rows)
+    assert (out / "summary.json").exists()
