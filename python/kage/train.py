@@ -99,7 +99,6 @@ class Args:
     cuda_graph: bool = field(default=False, metadata={"help": "replay the rollout's policy step as a CUDA graph"})
     fused_input: bool = field(default=False, metadata={
         "help": "one pass from uint8 frames to 4x4 blocks in the network's dtype; conv1 as the equal 2x2 conv"})
-    compile: bool = field(default=False, metadata={"help": "torch.compile the network (torch 2.x)"})
 
     @property
     def batch_size(self) -> int:
@@ -170,8 +169,6 @@ def validate(args: Args) -> List[str]:
         problems.append("at most 10 eval configs (the 11th would reuse the train config's evaluation seeds, §3.5)")
     if args.device == "cpu" and (args.bf16 or args.cuda_graph):
         problems.append("--bf16 and --cuda-graph are for --device cuda")
-    if args.compile and not hasattr(torch, "compile"):
-        problems.append(f"--compile needs torch 2.x; this is torch {torch.__version__}")
     return problems
 
 
@@ -552,7 +549,6 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
     if args.bf16:
         agent.input_dtype = torch.bfloat16
     agent.space_to_depth = args.fused_input
-    policy = torch.compile(agent) if args.compile else agent
     optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5)
     random = CounterRandom([a.seed for a in pack], device)
     counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
@@ -629,7 +625,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
     progress = rundir.Progress(args.num_iterations, args.batch_size * K)
     last_iteration = args.num_iterations if stop_after is None else min(args.num_iterations,
                                                                         start_iteration + stop_after - 1)
-    rollout = RolloutPolicy(policy, args, observe().shape, device)
+    rollout = RolloutPolicy(agent, args, observe().shape, device)
     # Episodes end only by truncation at episode_length (§2.3): when no episode is shorter than a rollout, an
     # environment ends at most one per rollout, and its final info still holds it when the rollout is over,
     # so the episode metrics are read once per rollout instead of after every step.
@@ -673,7 +669,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
                         final = torch.stack(final_frames)
                         if stack:  # the final frame on top of the episode's last stack
                             final = torch.cat([stack.stack[..., final.shape[-1]:], final], -1)
-                        reward = reward + args.gamma * policy(final)[1].float() * truncated
+                        reward = reward + args.gamma * agent(final)[1].float() * truncated
                 if normalizer:
                     reward = normalizer(reward, next_done)
                 rewards[step] = reward.clamp(args.reward_clip_min, args.reward_clip_max)
@@ -686,7 +682,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
 
         with torch.no_grad(), timer("forward"):  # §2.5 step 3
             with autocast(args):
-                next_value = policy(observe())[1].float()
+                next_value = agent(observe())[1].float()
             advantages, returns = compute_gae(rewards, values, dones, next_value, next_done, args.gamma,
                                               args.gae_lambda)
 
@@ -703,7 +699,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
                 mb = permutation[:, start:start + args.minibatch_size]
                 with timer("update_forward"):
                     with autocast(args):
-                        logits, new_value = policy(b_obs[runs_axis, mb])
+                        logits, new_value = agent(b_obs[runs_axis, mb])
                     logits, new_value = logits.float(), new_value.float()
                     new_logprob = torch.log_softmax(logits, -1).gather(-1, b_actions[runs_axis, mb, None]).squeeze(-1)
                     loss, pg_loss, v_loss, entropy, approx_kl, clipfrac = ppo_loss(
