@@ -9,7 +9,7 @@ import statistics
 
 import torch
 
-from kage.train import Agent
+from kage.agent import Agent
 
 VARIANTS = [  # (bf16, channels_last, fused_input)
     (False, False, False), (False, False, True), (True, False, True), (True, True, False), (True, True, True)]

@@ -158,6 +158,30 @@ class RunDir:
             self._log.close()
 
 
+def optimizer_run_state(optimizer: torch.optim.Adam, agent, run: int) -> dict:
+    """Run `run`'s Adam moments (in its parameters' shapes) and the shared step count."""
+    state = {}
+    for name, p in agent.named_parameters():
+        s = optimizer.state.get(p, {})
+        state[name] = {k: (agent.run_view(v)[run].cpu().clone() if k != "step" else
+                           v.cpu().clone() if torch.is_tensor(v) else v) for k, v in s.items()}
+    return state
+
+
+def load_optimizer(optimizer: torch.optim.Adam, agent, runs: List[dict]) -> None:
+    """Rebuilds the pack's Adam state from each run's saved part."""
+    for name, p in agent.named_parameters():
+        if not runs[0][name]:
+            continue
+        state = {}
+        for key, value in runs[0][name].items():
+            if key == "step":
+                state[key] = value.clone() if torch.is_tensor(value) else value
+            else:
+                state[key] = torch.empty_like(p).copy_(torch.cat([r[name][key] for r in runs]).to(p.device))
+        optimizer.state[p] = state
+
+
 def summarize(history: List[dict]) -> dict:
     series: Dict[str, List[Optional[float]]] = {}
     for point in history:

@@ -3,8 +3,8 @@ on one or more others, as the original's ppo_jax.py (and ppo_jax_multi_conf.py) 
 
     python3 -m kage.train --train-config-path T --eval-config-path E --seed S [--device cuda|cpu] [--out DIR]
 
-Read it top to bottom like CleanRL's ppo_atari_envpool.py: the flags (Args), the network, the losses,
-the evaluation, then the training loop. "§x.y" refers to the section of the baseline specification
+Read it top to bottom like CleanRL's ppo_atari_envpool.py: the flags (Args), the losses, then the
+training loop; the network is kage.agent (§1), the evaluation and its metrics kage.evaluation (§3-4). "§x.y" refers to the section of the baseline specification
 (kage-ppo-baseline.md) that a line implements. Quirks of the original are kept by default and marked
 QUIRK; a flag offers the corrected behaviour where one makes sense:
 - truncation is treated as termination (no bootstrap across the 500-step limit): --bootstrap-truncation;
@@ -34,17 +34,14 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
 import torch
-import torch.nn as nn
-import torch.nn.functional as F
 
 import kage
 from kage import rundir
+from kage.agent import Agent, autocast, entropy_of, sample_gumbel_max
 from kage.counter_random import CounterRandom
+from kage.evaluation import METRICS, EpisodeMetrics, evaluation_rows
 from kage.wrappers import FrameStack, RewardNormalizer
 
-METRICS = ("x", "y", "vx_mean", "vy_mean", "passed_distance", "progress", "jump_count", "success", "success_once")
-DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # §3.3
-TRAIN_OFFSET, EVAL_OFFSET, EVAL_OFFSET_STEP = 20_000, 10_000, 1_000  # §3.2
 ACTION_STREAM, SHUFFLE_STREAM = 1, 2  # the two random streams of a run (§2.4); evaluations use their own keys
 
 
@@ -184,113 +181,6 @@ def eval_labels(args: Args) -> List[str]:
     return labels
 
 
-# ---- the agent (§1) ----
-
-def orthogonal(out_features: int, in_features: int, gain: float, device) -> torch.Tensor:
-    """An orthogonal [out, in] matrix with gain `gain` (§1.3), drawn from torch's generator of `device`."""
-    weight = torch.empty(out_features, in_features, device=device)
-    nn.init.orthogonal_(weight, gain)
-    return weight
-
-
-class Agent(nn.Module):
-    """K agents (a pack; K = 1 for a lone run): NatureCNN torsos without padding, a 512-unit layer and two
-    linear heads each (§1.2). Run k owns the k-th group of every grouped convolution and the k-th matrix of
-    every batched linear layer, so one pass per layer evaluates all K."""
-
-    def __init__(self, seeds: List[int], channels: int = 3, height: int = 128, width: int = 128, device="cpu"):
-        super().__init__()
-        k = self.runs = len(seeds)
-        self.conv1 = nn.Conv2d(k * channels, k * 32, 8, stride=4, groups=k, device=device)
-        self.conv2 = nn.Conv2d(k * 32, k * 64, 4, stride=2, groups=k, device=device)
-        self.conv3 = nn.Conv2d(k * 64, k * 64, 3, stride=1, groups=k, device=device)
-        conv_h, conv_w = ((height - 8) // 4 + 1 - 4) // 2 + 1 - 2, ((width - 8) // 4 + 1 - 4) // 2 + 1 - 2
-        self.flat = 64 * conv_h * conv_w
-        self.fc_weight = nn.Parameter(torch.empty(k, self.flat, 512, device=device))
-        self.fc_bias = nn.Parameter(torch.zeros(k, 1, 512, device=device))
-        self.actor_weight = nn.Parameter(torch.empty(k, 512, 8, device=device))
-        self.actor_bias = nn.Parameter(torch.zeros(k, 1, 8, device=device))
-        self.critic_weight = nn.Parameter(torch.empty(k, 512, 1, device=device))
-        self.critic_bias = nn.Parameter(torch.zeros(k, 1, 1, device=device))
-        self.input_dtype = torch.float32  # bfloat16 under --bf16
-        self.space_to_depth = False  # --fused-input
-        with torch.no_grad():
-            for run, seed in enumerate(seeds):
-                self._initialise(run, seed, channels)
-
-    def _initialise(self, run: int, seed: int, channels: int) -> None:
-        """§1.3: orthogonal weights (gain sqrt 2 in the torso, 0.01 actor, 1 critic), zero biases; from the
-        run's seed, so a run starts the same alone or packed."""
-        torch.manual_seed(seed)
-        for conv, in_channels in ((self.conv1, channels), (self.conv2, 32), (self.conv3, 64)):
-            out, _, kh, kw = conv.weight.shape
-            out //= self.runs
-            group = conv.weight.view(self.runs, out, in_channels, kh, kw)[run]
-            group.copy_(orthogonal(out, in_channels * kh * kw, math.sqrt(2), group.device).view_as(group))
-            conv.bias.view(self.runs, out)[run].zero_()
-        for weight, gain in ((self.fc_weight, math.sqrt(2)), (self.actor_weight, 0.01), (self.critic_weight, 1.0)):
-            weight[run].copy_(orthogonal(weight.shape[2], weight.shape[1], gain, weight.device).T)
-
-    def forward(self, obs: torch.Tensor):
-        """uint8 [K, B, H, W, C] frames -> logits [K, B, 8] and values [K, B]. The first operation is the
-        conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups."""
-        k, b, h, w, c = obs.shape
-        if self.space_to_depth:
-            x = F.relu(self._conv1_space_to_depth(obs))
-        else:
-            x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
-        x = F.relu(self.conv2(x))
-        x = F.relu(self.conv3(x))
-        x = x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
-        hidden = F.relu(torch.baddbmm(self.fc_bias, x, self.fc_weight))
-        logits = torch.baddbmm(self.actor_bias, hidden, self.actor_weight)
-        value = torch.baddbmm(self.critic_bias, hidden, self.critic_weight).squeeze(-1)
-        return logits, value
-
-    def _input(self, frames: torch.Tensor) -> torch.Tensor:
-        """uint8 [B, H, W, C'] -> [B, C', H, W] / 255 in the input dtype, channels last when the weights are.
-        Under --bf16 the conversion goes straight to bfloat16: uint8 values are exact there, and x / 255
-        rounds to the bfloat16 that autocast would make of the float32 quotient (one pass, half the bytes)."""
-        x = frames.permute(0, 3, 1, 2)
-        if not self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
-            x = x.contiguous()
-        return x.to(self.input_dtype).div_(255.0)
-
-    def _conv1_space_to_depth(self, obs: torch.Tensor) -> torch.Tensor:
-        """conv1 (8x8, stride 4, C channels) as the equal 2x2, stride-1 convolution of the frames cut into
-        4x4 blocks of 16 C channels: the same products and sums (row 4a + p, column 4b + q of a filter
-        meets channel (c, p, q) at offset (a, b)), but 48 channels a group instead of 3, which the
-        convolution kernels use far better. The rearrangement is the same single copy the frames need
-        anyway (--fused-input)."""
-        k, b, h, w, c = obs.shape
-        h, w = h // 4 * 4, w // 4 * 4  # rows and columns past the last whole block are never read
-        blocks = obs[:, :, :h, :w].reshape(k, b, h // 4, 4, w // 4, 4, c).permute(1, 2, 4, 0, 6, 3, 5)
-        x = self._input(blocks.reshape(b, h // 4, w // 4, k * c * 16))
-        weight = self.conv1.weight  # [K*32, C, 8, 8] = [K*32, C, (a, p), (b, q)]
-        weight = weight.view(-1, c, 2, 4, 2, 4).permute(0, 1, 3, 5, 2, 4).reshape(-1, c * 16, 2, 2)
-        if self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
-            weight = weight.contiguous(memory_format=torch.channels_last)
-        return F.conv2d(x, weight, self.conv1.bias, stride=1, groups=k)
-
-    def run_view(self, tensor: torch.Tensor) -> torch.Tensor:
-        """A tensor shaped like a parameter (the parameter, its gradient, an Adam moment) as [K, ...]: the
-        leading axis split into the runs' parts, whatever the memory format."""
-        return tensor.unflatten(0, (self.runs, -1))
-
-
-def sample_gumbel_max(logits: torch.Tensor, uniform: torch.Tensor):
-    """Categorical sampling by the Gumbel-max trick (§1.4): the action and its log-probability."""
-    action = torch.argmax(logits - torch.log(-torch.log(uniform)), dim=-1)
-    logprob = torch.log_softmax(logits.float(), dim=-1).gather(-1, action[..., None]).squeeze(-1)
-    return action, logprob
-
-
-def entropy_of(logits: torch.Tensor) -> torch.Tensor:
-    """Entropy from log-softmax logits clipped at the smallest float32, so p log p is never 0 * -inf."""
-    log_p = torch.log_softmax(logits, dim=-1).clamp(min=torch.finfo(logits.dtype).min)
-    return -(log_p.exp() * log_p).sum(-1)
-
-
 # ---- the algorithm's arithmetic (§2.5 step 3, §2.6), with any leading run axes ----
 
 def compute_gae(rewards, values, dones, next_value, next_done, gamma: float, gae_lambda: float):
@@ -352,124 +242,6 @@ def clip_grad_norm_per_run(agent: Agent, max_norm: float) -> torch.Tensor:
     return norm
 
 
-# ---- episode metrics (§4) ----
-
-class EpisodeMetrics:
-    """Device views of the finished-episode fields of a list of batches, read each step without a copy
-    (§4.1): the k-th row is the k-th batch."""
-
-    def __init__(self, infos: List[dict], dists_to_success: List[float], device):
-        self.masks = [torch.from_dlpack(info["_final"]) for info in infos]
-        names = ("return", "length") + METRICS
-        self.fields = {n: [torch.from_dlpack(info["final_info"][n]) for info in infos] for n in names}
-        self.dist_to_success = torch.tensor(dists_to_success, device=device)[:, None]
-
-    def mask(self) -> torch.Tensor:
-        return torch.stack(self.masks).float()
-
-    def rows(self) -> torch.Tensor:
-        """[K, 12, N] float32: finished mask, return, length and the nine metrics of §4.1. QUIRK: success is
-        recomputed with a strict > at the terminal state (the core uses >=)."""
-        f = {n: torch.stack(v).float() for n, v in self.fields.items()}
-        f["success"] = (f["passed_distance"] > self.dist_to_success).float()
-        return torch.stack([self.mask(), f["return"], f["length"]] + [f[m] for m in METRICS], dim=1)
-
-
-@torch.no_grad()
-def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]], dists: List[List[float]],
-             episodes: int, episode_length: int, args: Args) -> List[List[Dict[str, Optional[float]]]]:
-    """The evaluations of each run's configs (§3.2; envs[k][c]: run k's c-th config), each in fresh
-    environments with its own seed and sampling stream, all stepped together: one forward pass per step.
-    Sampled actions until `episodes` episodes have finished in each. Steps are queued without a host
-    synchronisation: every KAGE episode ends by truncation at `episode_length` (§2.3), so
-    ceil(episodes / envs) waves of episode_length steps finish them; the host checks the counts once,
-    after the waves (and steps on, a wave at a time, if one fell short)."""
-    device = next(agent.parameters()).device
-    flat_envs = [e for run in envs for e in run]
-    configs, n = len(envs[0]), flat_envs[0].num_envs
-    random = CounterRandom([s for run in seeds for s in run], device)
-    counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
-    infos = []
-    for env, seed in zip(flat_envs, [s for run in seeds for s in run]):
-        infos.append(env.reset(seed=seed)[1])
-    frames = [torch.from_dlpack(env.outputs()[0]) for env in flat_envs]
-    metrics = EpisodeMetrics(infos, [d for run in dists for d in run], device)
-    stack = FrameStack(torch.stack(frames)) if args.use_frame_stack else None
-    chunk = -(-episodes // n) * episode_length
-    records, waves = [], 0
-    while True:
-        noise = random.uniform(0, counter.fill_(waves), (chunk, n, 8))  # each evaluation's draws for the chunk
-        waves += 1
-        for step in range(chunk):
-            obs = stack.stack if stack else torch.stack(frames)             # [K * C, E, H, W, ch]
-            with autocast(args):
-                logits, _ = agent(obs.view(len(envs), configs * n, *obs.shape[2:]))
-            logits = logits.float().view(len(flat_envs), n, 8)
-            # QUIRK: sampled, not greedy (Gumbel-max: an exact categorical sampler with no host check).
-            actions = logits.argmax(-1) if args.eval_greedy else sample_gumbel_max(logits, noise[:, step])[0]
-            for env, action in zip(flat_envs, actions):
-                env.step(action)
-            if stack:
-                stack.push(torch.stack(frames), metrics.mask())
-            records.append(metrics.rows())
-        if torch.stack(records)[:, :, 0].sum((0, 2)).min().item() >= episodes:  # the one host read
-            break
-    host = torch.stack(records).cpu()
-    results = [summarize_evaluation(host[:, i], episodes) for i in range(len(flat_envs))]
-    return [results[k * configs:(k + 1) * configs] for k in range(len(envs))]
-
-
-def summarize_evaluation(records: torch.Tensor, episodes: int) -> Dict[str, Optional[float]]:
-    """§3.2 steps 3-4 from [steps, 12, N] records: return and length are means over the first `episodes`
-    finished episodes (in step, then environment order) whose return is not exactly 0 (QUIRK: zero
-    returns dropped; all zero gives no value); each metric is its sum over every episode that finished
-    up to the step where the count reached `episodes`, over max(1, that number)."""
-    finished = records[:, 0] > 0                                           # [S, N]
-    per_step = finished.sum(1).cumsum(0)
-    last_step = int(torch.nonzero(per_step >= episodes)[0]) if bool((per_step >= episodes).any()) else len(per_step) - 1
-    values = records[: last_step + 1].permute(0, 2, 1)[finished[: last_step + 1]]  # [finished, 12], step-major
-    listed = values[:episodes]
-    nonzero = listed[:, 1] != 0
-    result: Dict[str, Optional[float]] = {
-        "episodes": int(values.shape[0]),
-        "return": float(listed[nonzero, 1].mean()) if bool(nonzero.any()) else None,
-        "length": float(listed[nonzero, 2].mean()) if bool(nonzero.any()) else None,
-    }
-    count = max(1, values.shape[0])
-    for i, m in enumerate(METRICS):
-        result[m] = float(values[:, 3 + i].sum() / count)
-    return result
-
-
-def absolute_difference(a: Optional[float], b: Optional[float]) -> Optional[float]:
-    return None if a is None or b is None else abs(a - b)
-
-
-def evaluation_rows(agent: Agent, runs: List["Run"], args: Args, iteration: int, global_step: int) -> List[dict]:
-    """Evaluates each run's current parameters on its train config and on each eval config (§3.2; seed
-    offsets 20,000 for the train config, 10,000 + 1,000 i for the i-th eval config), and the absolute
-    differences train - eval (§3.3): one log row per run."""
-    start = time.perf_counter()
-    agent.eval()
-    seeds = [[r.args.seed + (TRAIN_OFFSET if i == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * (i - 1)) + iteration
-              for i in range(len(r.eval_envs))] for r in runs]
-    configs = [[r.specs[label]["config"] for label in r.eval_envs] for r in runs]
-    results = evaluate(agent, [list(r.eval_envs.values()) for r in runs], seeds,
-                       [[c["dist_to_success"] for c in run] for run in configs], args.eval_episodes,
-                       max(c["episode_length"] for run in configs for c in run), args)
-    agent.train()
-    rows = []
-    for run, result in zip(runs, results):
-        train, *evals = result
-        labels = list(run.eval_envs)[1:]
-        rows.append({"kind": "eval", "iteration": iteration, "global_step": global_step, "train": train,
-                     "evals": dict(zip(labels, evals)),
-                     "diffs": {label: {m: absolute_difference(train[m], ev[m]) for m in DIFF_METRICS}
-                               for label, ev in zip(labels, evals)},
-                     "seconds": time.perf_counter() - start})
-    return rows
-
-
 # ---- the runs of a pack ----
 
 @dataclass
@@ -506,11 +278,6 @@ def check_pack(runs: List[Args]) -> Args:
         if len(eval_paths(args)) != len(eval_paths(runs[0])):
             raise SystemExit("kage.train: packed runs must evaluate the same number of configs")
     return runs[0]
-
-
-def autocast(args: Args):
-    """bfloat16 autocast for the network under --bf16, else nothing."""
-    return torch.autocast("cuda", dtype=torch.bfloat16) if args.bf16 else contextlib.nullcontext()
 
 
 class NoTimer:
@@ -598,7 +365,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
                 for name, value in c["normalizer"].items():
                     getattr(normalizer, name)[k] = value.to(device)
             run.history = c["history"]
-        load_optimizer(optimizer, agent, [c["optimizer"] for c in checkpoints])
+        rundir.load_optimizer(optimizer, agent, [c["optimizer"] for c in checkpoints])
         c = checkpoints[0]
         start_iteration, global_step = c["iteration"] + 1, c["global_step"]
         optimizer_steps, train_seconds = c["optimizer_steps"], c["train_seconds"]
@@ -615,7 +382,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
                 "iteration": iteration, "global_step": global_step, "optimizer_steps": optimizer_steps,
                 "train_seconds": train_seconds,
                 "agent": {n: agent.run_view(p)[k].detach().cpu().clone() for n, p in agent.named_parameters()},
-                "optimizer": optimizer_run_state(optimizer, agent, k), "env_state": run.env.save_state(),
+                "optimizer": rundir.optimizer_run_state(optimizer, agent, k), "env_state": run.env.save_state(),
                 "next_done": next_done[k].cpu(), "last_return": last_return[k].cpu(),
                 "last_length": last_length[k].cpu(), "any_finished": any_finished[k].cpu(),
                 "frame_stack": stack.stack[k].cpu() if stack else None,
@@ -664,7 +431,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
                 if not read_once:
                     tally(episode.rows(), finished)
                 if args.bootstrap_truncation:
-                    with torch.no_grad(), autocast(args):  # the value of the observation the truncation discarded
+                    with torch.no_grad(), autocast(args.bf16):  # the value of the observation the truncation discarded
                         truncated = torch.stack(env_truncated).float() * finished
                         final = torch.stack(final_frames)
                         if stack:  # the final frame on top of the episode's last stack
@@ -681,7 +448,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
         global_step += args.batch_size  # §2.5 step 2
 
         with torch.no_grad(), timer("forward"):  # §2.5 step 3
-            with autocast(args):
+            with autocast(args.bf16):
                 next_value = agent(observe())[1].float()
             advantages, returns = compute_gae(rewards, values, dones, next_value, next_done, args.gamma,
                                               args.gae_lambda)
@@ -698,7 +465,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
             for start in range(0, args.batch_size, args.minibatch_size):
                 mb = permutation[:, start:start + args.minibatch_size]
                 with timer("update_forward"):
-                    with autocast(args):
+                    with autocast(args.bf16):
                         logits, new_value = agent(b_obs[runs_axis, mb])
                     logits, new_value = logits.float(), new_value.float()
                     new_logprob = torch.log_softmax(logits, -1).gather(-1, b_actions[runs_axis, mb, None]).squeeze(-1)
@@ -773,7 +540,7 @@ class RolloutPolicy:
                 self.outputs = self._step()
 
     def _step(self):
-        with autocast(self.args):
+        with autocast(self.args.bf16):
             logits, value = self.policy(self.obs)
         action, logprob = sample_gumbel_max(logits.float(), self.uniform)
         return action, logprob, value.float()
@@ -806,30 +573,6 @@ def train_row(s: List[float], iteration: int, global_step: int, train_seconds: f
     if s[11] > 0:
         row.update({f"train/avg_{m}": total / s[11] for m, total in zip(METRICS, s[12:])})
     return row
-
-
-def optimizer_run_state(optimizer: torch.optim.Adam, agent: Agent, run: int) -> dict:
-    """Run `run`'s Adam moments (in its parameters' shapes) and the shared step count."""
-    state = {}
-    for name, p in agent.named_parameters():
-        s = optimizer.state.get(p, {})
-        state[name] = {k: (agent.run_view(v)[run].cpu().clone() if k != "step" else
-                           v.cpu().clone() if torch.is_tensor(v) else v) for k, v in s.items()}
-    return state
-
-
-def load_optimizer(optimizer: torch.optim.Adam, agent: Agent, runs: List[dict]) -> None:
-    """Rebuilds the pack's Adam state from each run's saved part."""
-    for name, p in agent.named_parameters():
-        if not runs[0][name]:
-            continue
-        state = {}
-        for key, value in runs[0][name].items():
-            if key == "step":
-                state[key] = value.clone() if torch.is_tensor(value) else value
-            else:
-                state[key] = torch.empty_like(p).copy_(torch.cat([r[name][key] for r in runs]).to(p.device))
-        optimizer.state[p] = state
 
 
 def main(argv: Optional[List[str]] = None) -> int:

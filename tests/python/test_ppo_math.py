@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 import torch
 
+from kage.agent import Agent, entropy_of, sample_gumbel_max
 from kage.counter_random import CounterRandom
-from kage.train import (METRICS, Agent, Args, EpisodeMetrics, clip_grad_norm_per_run, compute_gae, entropy_of,
-                        ppo_loss, sample_gumbel_max, summarize_evaluation)
+from kage.evaluation import METRICS, EpisodeMetrics, summarize_evaluation
+from kage.train import Args, clip_grad_norm_per_run, compute_gae, ppo_loss
 
 
 def test_gae_on_a_three_step_batch():

@@ -1,0 +1,120 @@
+"""The PPO-CNN baseline's network and action distribution (kage-ppo-baseline.md §1), for a pack of K runs
+(K = 1 for a lone run): each run owns one group of every grouped convolution and one matrix of every
+batched linear layer, so one pass per layer evaluates all K."""
+import contextlib
+import math
+from typing import List
+
+import torch
+import torch.nn as nn
+import torch.nn.functional as F
+
+
+def autocast(bf16: bool):
+    """bfloat16 autocast for the network under --bf16, else nothing."""
+    return torch.autocast("cuda", dtype=torch.bfloat16) if bf16 else contextlib.nullcontext()
+
+
+def orthogonal(out_features: int, in_features: int, gain: float, device) -> torch.Tensor:
+    """An orthogonal [out, in] matrix with gain `gain` (§1.3), drawn from torch's generator of `device`."""
+    weight = torch.empty(out_features, in_features, device=device)
+    nn.init.orthogonal_(weight, gain)
+    return weight
+
+
+class Agent(nn.Module):
+    """K agents (a pack; K = 1 for a lone run): NatureCNN torsos without padding, a 512-unit layer and two
+    linear heads each (§1.2). Run k owns the k-th group of every grouped convolution and the k-th matrix of
+    every batched linear layer, so one pass per layer evaluates all K."""
+
+    def __init__(self, seeds: List[int], channels: int = 3, height: int = 128, width: int = 128, device="cpu"):
+        super().__init__()
+        k = self.runs = len(seeds)
+        self.conv1 = nn.Conv2d(k * channels, k * 32, 8, stride=4, groups=k, device=device)
+        self.conv2 = nn.Conv2d(k * 32, k * 64, 4, stride=2, groups=k, device=device)
+        self.conv3 = nn.Conv2d(k * 64, k * 64, 3, stride=1, groups=k, device=device)
+        conv_h, conv_w = ((height - 8) // 4 + 1 - 4) // 2 + 1 - 2, ((width - 8) // 4 + 1 - 4) // 2 + 1 - 2
+        self.flat = 64 * conv_h * conv_w
+        self.fc_weight = nn.Parameter(torch.empty(k, self.flat, 512, device=device))
+        self.fc_bias = nn.Parameter(torch.zeros(k, 1, 512, device=device))
+        self.actor_weight = nn.Parameter(torch.empty(k, 512, 8, device=device))
+        self.actor_bias = nn.Parameter(torch.zeros(k, 1, 8, device=device))
+        self.critic_weight = nn.Parameter(torch.empty(k, 512, 1, device=device))
+        self.critic_bias = nn.Parameter(torch.zeros(k, 1, 1, device=device))
+        self.input_dtype = torch.float32  # bfloat16 under --bf16
+        self.space_to_depth = False  # --fused-input
+        with torch.no_grad():
+            for run, seed in enumerate(seeds):
+                self._initialise(run, seed, channels)
+
+    def _initialise(self, run: int, seed: int, channels: int) -> None:
+        """§1.3: orthogonal weights (gain sqrt 2 in the torso, 0.01 actor, 1 critic), zero biases; from the
+        run's seed, so a run starts the same alone or packed."""
+        torch.manual_seed(seed)
+        for conv, in_channels in ((self.conv1, channels), (self.conv2, 32), (self.conv3, 64)):
+            out, _, kh, kw = conv.weight.shape
+            out //= self.runs
+            group = conv.weight.view(self.runs, out, in_channels, kh, kw)[run]
+            group.copy_(orthogonal(out, in_channels * kh * kw, math.sqrt(2), group.device).view_as(group))
+            conv.bias.view(self.runs, out)[run].zero_()
+        for weight, gain in ((self.fc_weight, math.sqrt(2)), (self.actor_weight, 0.01), (self.critic_weight, 1.0)):
+            weight[run].copy_(orthogonal(weight.shape[2], weight.shape[1], gain, weight.device).T)
+
+    def forward(self, obs: torch.Tensor):
+        """uint8 [K, B, H, W, C] frames -> logits [K, B, 8] and values [K, B]. The first operation is the
+        conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups."""
+        k, b, h, w, c = obs.shape
+        if self.space_to_depth:
+            x = F.relu(self._conv1_space_to_depth(obs))
+        else:
+            x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
+        x = F.relu(self.conv2(x))
+        x = F.relu(self.conv3(x))
+        x = x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
+        hidden = F.relu(torch.baddbmm(self.fc_bias, x, self.fc_weight))
+        logits = torch.baddbmm(self.actor_bias, hidden, self.actor_weight)
+        value = torch.baddbmm(self.critic_bias, hidden, self.critic_weight).squeeze(-1)
+        return logits, value
+
+    def _input(self, frames: torch.Tensor) -> torch.Tensor:
+        """uint8 [B, H, W, C'] -> [B, C', H, W] / 255 in the input dtype, channels last when the weights are.
+        Under --bf16 the conversion goes straight to bfloat16: uint8 values are exact there, and x / 255
+        rounds to the bfloat16 that autocast would make of the float32 quotient (one pass, half the bytes)."""
+        x = frames.permute(0, 3, 1, 2)
+        if not self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
+            x = x.contiguous()
+        return x.to(self.input_dtype).div_(255.0)
+
+    def _conv1_space_to_depth(self, obs: torch.Tensor) -> torch.Tensor:
+        """conv1 (8x8, stride 4, C channels) as the equal 2x2, stride-1 convolution of the frames cut into
+        4x4 blocks of 16 C channels: the same products and sums (row 4a + p, column 4b + q of a filter
+        meets channel (c, p, q) at offset (a, b)), but 48 channels a group instead of 3, which the
+        convolution kernels use far better. The rearrangement is the same single copy the frames need
+        anyway (--fused-input)."""
+        k, b, h, w, c = obs.shape
+        h, w = h // 4 * 4, w // 4 * 4  # rows and columns past the last whole block are never read
+        blocks = obs[:, :, :h, :w].reshape(k, b, h // 4, 4, w // 4, 4, c).permute(1, 2, 4, 0, 6, 3, 5)
+        x = self._input(blocks.reshape(b, h // 4, w // 4, k * c * 16))
+        weight = self.conv1.weight  # [K*32, C, 8, 8] = [K*32, C, (a, p), (b, q)]
+        weight = weight.view(-1, c, 2, 4, 2, 4).permute(0, 1, 3, 5, 2, 4).reshape(-1, c * 16, 2, 2)
+        if self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
+            weight = weight.contiguous(memory_format=torch.channels_last)
+        return F.conv2d(x, weight, self.conv1.bias, stride=1, groups=k)
+
+    def run_view(self, tensor: torch.Tensor) -> torch.Tensor:
+        """A tensor shaped like a parameter (the parameter, its gradient, an Adam moment) as [K, ...]: the
+        leading axis split into the runs' parts, whatever the memory format."""
+        return tensor.unflatten(0, (self.runs, -1))
+
+
+def sample_gumbel_max(logits: torch.Tensor, uniform: torch.Tensor):
+    """Categorical sampling by the Gumbel-max trick (§1.4): the action and its log-probability."""
+    action = torch.argmax(logits - torch.log(-torch.log(uniform)), dim=-1)
+    logprob = torch.log_softmax(logits.float(), dim=-1).gather(-1, action[..., None]).squeeze(-1)
+    return action, logprob
+
+
+def entropy_of(logits: torch.Tensor) -> torch.Tensor:
+    """Entropy from log-softmax logits clipped at the smallest float32, so p log p is never 0 * -inf."""
+    log_p = torch.log_softmax(logits, dim=-1).clamp(min=torch.finfo(logits.dtype).min)
+    return -(log_p.exp() * log_p).sum(-1)

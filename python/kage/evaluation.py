@@ -1,0 +1,132 @@
+"""The baseline's evaluation protocol and episode metrics (kage-ppo-baseline.md §3, §4): every run of a
+pack evaluated on its train config and each eval config at once, in fresh environments, and the
+metrics read from the finished episodes' final info."""
+import time
+from typing import Dict, List, Optional
+
+import torch
+
+import kage
+from kage.agent import Agent, autocast, sample_gumbel_max
+from kage.counter_random import CounterRandom
+from kage.wrappers import FrameStack
+
+METRICS = ("x", "y", "vx_mean", "vy_mean", "passed_distance", "progress", "jump_count", "success", "success_once")
+DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # §3.3
+TRAIN_OFFSET, EVAL_OFFSET, EVAL_OFFSET_STEP = 20_000, 10_000, 1_000  # §3.2
+
+
+class EpisodeMetrics:
+    """Device views of the finished-episode fields of a list of batches, read each step without a copy
+    (§4.1): the k-th row is the k-th batch."""
+
+    def __init__(self, infos: List[dict], dists_to_success: List[float], device):
+        self.masks = [torch.from_dlpack(info["_final"]) for info in infos]
+        names = ("return", "length") + METRICS
+        self.fields = {n: [torch.from_dlpack(info["final_info"][n]) for info in infos] for n in names}
+        self.dist_to_success = torch.tensor(dists_to_success, device=device)[:, None]
+
+    def mask(self) -> torch.Tensor:
+        return torch.stack(self.masks).float()
+
+    def rows(self) -> torch.Tensor:
+        """[K, 12, N] float32: finished mask, return, length and the nine metrics of §4.1. QUIRK: success is
+        recomputed with a strict > at the terminal state (the core uses >=)."""
+        f = {n: torch.stack(v).float() for n, v in self.fields.items()}
+        f["success"] = (f["passed_distance"] > self.dist_to_success).float()
+        return torch.stack([self.mask(), f["return"], f["length"]] + [f[m] for m in METRICS], dim=1)
+
+
+@torch.no_grad()
+def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]], dists: List[List[float]],
+             episodes: int, episode_length: int, args) -> List[List[Dict[str, Optional[float]]]]:
+    """The evaluations of each run's configs (§3.2; envs[k][c]: run k's c-th config), each in fresh
+    environments with its own seed and sampling stream, all stepped together: one forward pass per step.
+    Sampled actions until `episodes` episodes have finished in each. Steps are queued without a host
+    synchronisation: every KAGE episode ends by truncation at `episode_length` (§2.3), so
+    ceil(episodes / envs) waves of episode_length steps finish them; the host checks the counts once,
+    after the waves (and steps on, a wave at a time, if one fell short)."""
+    device = next(agent.parameters()).device
+    flat_envs = [e for run in envs for e in run]
+    configs, n = len(envs[0]), flat_envs[0].num_envs
+    random = CounterRandom([s for run in seeds for s in run], device)
+    counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
+    infos = []
+    for env, seed in zip(flat_envs, [s for run in seeds for s in run]):
+        infos.append(env.reset(seed=seed)[1])
+    frames = [torch.from_dlpack(env.outputs()[0]) for env in flat_envs]
+    metrics = EpisodeMetrics(infos, [d for run in dists for d in run], device)
+    stack = FrameStack(torch.stack(frames)) if args.use_frame_stack else None
+    chunk = -(-episodes // n) * episode_length
+    records, waves = [], 0
+    while True:
+        noise = random.uniform(0, counter.fill_(waves), (chunk, n, 8))  # each evaluation's draws for the chunk
+        waves += 1
+        for step in range(chunk):
+            obs = stack.stack if stack else torch.stack(frames)             # [K * C, E, H, W, ch]
+            with autocast(args.bf16):
+                logits, _ = agent(obs.view(len(envs), configs * n, *obs.shape[2:]))
+            logits = logits.float().view(len(flat_envs), n, 8)
+            # QUIRK: sampled, not greedy (Gumbel-max: an exact categorical sampler with no host check).
+            actions = logits.argmax(-1) if args.eval_greedy else sample_gumbel_max(logits, noise[:, step])[0]
+            for env, action in zip(flat_envs, actions):
+                env.step(action)
+            if stack:
+                stack.push(torch.stack(frames), metrics.mask())
+            records.append(metrics.rows())
+        if torch.stack(records)[:, :, 0].sum((0, 2)).min().item() >= episodes:  # the one host read
+            break
+    host = torch.stack(records).cpu()
+    results = [summarize_evaluation(host[:, i], episodes) for i in range(len(flat_envs))]
+    return [results[k * configs:(k + 1) * configs] for k in range(len(envs))]
+
+
+def summarize_evaluation(records: torch.Tensor, episodes: int) -> Dict[str, Optional[float]]:
+    """§3.2 steps 3-4 from [steps, 12, N] records: return and length are means over the first `episodes`
+    finished episodes (in step, then environment order) whose return is not exactly 0 (QUIRK: zero
+    returns dropped; all zero gives no value); each metric is its sum over every episode that finished
+    up to the step where the count reached `episodes`, over max(1, that number)."""
+    finished = records[:, 0] > 0                                           # [S, N]
+    per_step = finished.sum(1).cumsum(0)
+    last_step = int(torch.nonzero(per_step >= episodes)[0]) if bool((per_step >= episodes).any()) else len(per_step) - 1
+    values = records[: last_step + 1].permute(0, 2, 1)[finished[: last_step + 1]]  # [finished, 12], step-major
+    listed = values[:episodes]
+    nonzero = listed[:, 1] != 0
+    result: Dict[str, Optional[float]] = {
+        "episodes": int(values.shape[0]),
+        "return": float(listed[nonzero, 1].mean()) if bool(nonzero.any()) else None,
+        "length": float(listed[nonzero, 2].mean()) if bool(nonzero.any()) else None,
+    }
+    count = max(1, values.shape[0])
+    for i, m in enumerate(METRICS):
+        result[m] = float(values[:, 3 + i].sum() / count)
+    return result
+
+
+def absolute_difference(a: Optional[float], b: Optional[float]) -> Optional[float]:
+    return None if a is None or b is None else abs(a - b)
+
+
+def evaluation_rows(agent: Agent, runs: list, args, iteration: int, global_step: int) -> List[dict]:
+    """Evaluates each run's current parameters on its train config and on each eval config (§3.2; seed
+    offsets 20,000 for the train config, 10,000 + 1,000 i for the i-th eval config), and the absolute
+    differences train - eval (§3.3): one log row per run."""
+    start = time.perf_counter()
+    agent.eval()
+    seeds = [[r.args.seed + (TRAIN_OFFSET if i == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * (i - 1)) + iteration
+              for i in range(len(r.eval_envs))] for r in runs]
+    configs = [[r.specs[label]["config"] for label in r.eval_envs] for r in runs]
+    results = evaluate(agent, [list(r.eval_envs.values()) for r in runs], seeds,
+                       [[c["dist_to_success"] for c in run] for run in configs], args.eval_episodes,
+                       max(c["episode_length"] for run in configs for c in run), args)
+    agent.train()
+    rows = []
+    for run, result in zip(runs, results):
+        train, *evals = result
+        labels = list(run.eval_envs)[1:]
+        rows.append({"kind": "eval", "iteration": iteration, "global_step": global_step, "train": train,
+                     "evals": dict(zip(labels, evals)),
+                     "diffs": {label: {m: absolute_difference(train[m], ev[m]) for m in DIFF_METRICS}
+                               for label, ev in zip(labels, evals)},
+                     "seconds": time.perf_counter() - start})
+    return rows
