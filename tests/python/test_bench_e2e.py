@@ -1,6 +1,6 @@
-"""kage.bench end to end on the CPU: run two KAGE-Bench pairs with one seed and tiny flags, then report
-(tables in Markdown, CSV and JSON, and PNG plots); a second run skips the finished runs, and a changed
-config or other trainer flags are refused."""
+"""kage.bench end to end on the CPU: run two KAGE-Bench pairs with one seed and tiny flags, packed into one
+process, then report (tables in Markdown, CSV and JSON, and PNG plots); a second run skips the finished
+runs, and a changed config or other trainer flags are refused."""
 import csv
 import json
 import subprocess
@@ -25,8 +25,10 @@ def run(out, *extra):
 
 def test_run_then_report(tmp_path):
     out = tmp_path / "bench"
-    first = run(out)
+    first = run(out, "--pack", "2")
     assert first.returncode == 0, first.stderr
+    pack = json.loads((out / "packs" / "pack_0.json").read_text())
+    assert [r["seed"] for r in pack["runs"]] == [1, 1] and len({r["train_config_path"] for r in pack["runs"]}) == 1
     for pair in PAIRS:
         run_dir = out / "runs" / pair / "seed_1"
         assert (run_dir / "summary.json").exists(), (run_dir / "train.log").read_text()
