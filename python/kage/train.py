@@ -4,9 +4,10 @@ on one or more others, as the original's ppo_jax.py (and ppo_jax_multi_conf.py) 
     python3 -m kage.train --train-config-path T --eval-config-path E --seed S [--device cuda|cpu] [--out DIR]
 
 Read it top to bottom like CleanRL's ppo_atari_envpool.py: the flags (Args), the losses, then the
-training loop; the network is kage.agent (§1), the evaluation and its metrics kage.evaluation (§3-4). "§x.y" refers to the section of the baseline specification
-(kage-ppo-baseline.md) that a line implements. Quirks of the original are kept by default and marked
-QUIRK; a flag offers the corrected behaviour where one makes sense:
+training loop; the network is kage.agent (§1), the evaluation and its metrics kage.evaluation (§3-4).
+"§x.y" refers to the section of the baseline specification (kage-ppo-baseline.md) that a line implements.
+Quirks of the original are kept by default and marked QUIRK; a flag offers the corrected behaviour where
+one makes sense:
 - truncation is treated as termination (no bootstrap across the 500-step limit): --bootstrap-truncation;
 - evaluation samples its actions: --eval-greedy takes the most likely action instead;
 - `success` is recomputed with a strict `>` at the terminal state, and the plots labelled "success rate"
