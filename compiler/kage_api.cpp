@@ -78,8 +78,7 @@ std::string host_actions(const Actions& a, int32_t n, std::vector<int32_t>* out)
     const int64_t v = a.dtype == DType::kInt64 ? static_cast<const int64_t*>(a.data)[at]
                                                : static_cast<const int32_t*>(a.data)[at];
     if (v < 0 || v > 7)
-      return "action " + std::to_string(v) + " for environment " + std::to_string(i) +
-             ": an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump)";
+      return "action " + std::to_string(v) + " for environment " + std::to_string(i) + ": " + action_range_text();
     (*out)[static_cast<size_t>(i)] = static_cast<int32_t>(v);
   }
   return {};
@@ -240,8 +239,11 @@ class GpuEnv final : public Env {
   bool copy_obs(uint8_t* dst, std::string* e) const override { return bind(e) && batch_.download_obs(dst, e); }
   bool synchronize(std::string* e) override { return bind(e) && batch_.synchronize(e) && no_pending_error(e); }
   std::string pending_error() override {
-    const std::string problem = batch_.take_action_error();
-    return problem.empty() ? problem : "kage: " + problem;
+    const std::optional<ActionError> e = batch_.take_action_error();
+    if (!e) return {};
+    return "kage: the actions of step " + std::to_string(e->step) + " held " + std::to_string(e->value) +
+           " for environment " + std::to_string(e->env) + ": " + action_range_text() +
+           "; that step ran with the value masked to its low 3 bits";
   }
   bool save_state(std::vector<uint8_t>* out, std::string* e) const override {
     return bind(e) && batch_.save_state(hash_, out, e);
@@ -341,6 +343,8 @@ std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::st
 }
 
 }  // namespace
+
+const char* action_range_text() { return "an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump)"; }
 
 const InfoFieldDesc* info_fields(int32_t* count) {
   *count = static_cast<int32_t>(std::size(kInfoFields));

@@ -10,6 +10,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -33,37 +34,18 @@ OpenErrors& open_errors() {
 
 void raise_value_error(const std::string& message) { throw py::value_error(message); }
 
-py::dtype numpy_dtype(kage::DType t) {
-  switch (t) {
-    case kage::DType::kUInt8: return py::dtype::of<uint8_t>();
-    case kage::DType::kInt32: return py::dtype::of<int32_t>();
-    case kage::DType::kInt64: return py::dtype::of<int64_t>();
-    case kage::DType::kFloat32: return py::dtype::of<float>();
-  }
-  return py::dtype::of<uint8_t>();
-}
+/// Each kage::DType (in its enum order) as DLPack, __array_interface__ and byte size see it.
+struct DTypeFacts {
+  DLDataType dl;
+  const char* typestr;
+  size_t bytes;
+};
+constexpr DTypeFacts kDTypes[] = {
+    {{kDLUInt, 8, 1}, "|u1", 1}, {{kDLInt, 32, 1}, "<i4", 4}, {{kDLInt, 64, 1}, "<i8", 8}, {{kDLFloat, 32, 1}, "<f4", 4}};
+static_assert(std::size(kDTypes) == static_cast<size_t>(kage::DType::kFloat32) + 1, "a DType without facts");
 
-DLDataType dl_dtype(kage::DType t) {
-  switch (t) {
-    case kage::DType::kUInt8: return {kDLUInt, 8, 1};
-    case kage::DType::kInt32: return {kDLInt, 32, 1};
-    case kage::DType::kInt64: return {kDLInt, 64, 1};
-    case kage::DType::kFloat32: return {kDLFloat, 32, 1};
-  }
-  return {kDLUInt, 8, 1};
-}
-
-const char* typestr(kage::DType t) {
-  switch (t) {
-    case kage::DType::kUInt8: return "|u1";
-    case kage::DType::kInt32: return "<i4";
-    case kage::DType::kInt64: return "<i8";
-    case kage::DType::kFloat32: return "<f4";
-  }
-  return "|u1";
-}
-
-size_t dtype_bytes(kage::DType t) { return t == kage::DType::kUInt8 ? 1 : t == kage::DType::kInt64 ? 8 : 4; }
+const DTypeFacts& facts(kage::DType t) { return kDTypes[static_cast<size_t>(t)]; }
+py::dtype numpy_dtype(kage::DType t) { return py::dtype(facts(t).typestr); }
 
 /// One output array of a batch on the GPU: device memory owned by the batch.
 class DeviceArray {
@@ -89,7 +71,7 @@ class DeviceArray {
     t->dl_tensor.data = const_cast<void*>(data_);
     t->dl_tensor.device = {kDLCUDA, 0};
     t->dl_tensor.ndim = static_cast<int32_t>(ctx->shape.size());
-    t->dl_tensor.dtype = dl_dtype(dtype_);
+    t->dl_tensor.dtype = facts(dtype_).dl;
     t->dl_tensor.shape = ctx->shape.data();
     t->dl_tensor.strides = nullptr;
     t->dl_tensor.byte_offset = 0;
@@ -113,7 +95,7 @@ class DeviceArray {
     py::tuple shape(shape_.size());
     for (size_t i = 0; i < shape_.size(); ++i) shape[i] = shape_[i];
     d["shape"] = shape;
-    d["typestr"] = typestr(dtype_);
+    d["typestr"] = facts(dtype_).typestr;
     d["data"] = py::make_tuple(reinterpret_cast<uintptr_t>(data_), false);
     d["version"] = 3;
     d["strides"] = py::none();
@@ -206,7 +188,7 @@ class PyEnv {
     auto* keep = new std::shared_ptr<kage::Env>(env_);
     py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<kage::Env>*>(p); });
     std::vector<py::ssize_t> strides(shape.size());
-    py::ssize_t stride = static_cast<py::ssize_t>(dtype_bytes(dtype));
+    py::ssize_t stride = static_cast<py::ssize_t>(facts(dtype).bytes);
     for (size_t i = shape.size(); i-- > 0;) {
       strides[i] = stride;
       stride *= shape[i];
@@ -351,7 +333,7 @@ class PyEnv {
 
   /// A failed reset or step: an out-of-range action is a ValueError, anything else a RuntimeError.
   static void raise_step_error(const std::string& error) {
-    if (error.find("an action is an integer in 0..7") != std::string::npos) raise_value_error(error);
+    if (error.find(kage::action_range_text()) != std::string::npos) raise_value_error(error);
     throw std::runtime_error(error);
   }
 
@@ -426,6 +408,7 @@ PYBIND11_MODULE(_kage, m) {
       "Exception classes open() raises for a config, file, device, usage and any other error.");
 
   m.def("gpu_backend_built", &kage::gpu_backend_built);
+  m.def("action_range_text", &kage::action_range_text, "The text in every error about an action outside 0..7.");
   m.def("resolve", [](const std::string& path, const std::string& asset_root) {
     return front_end_json(kage::python::resolve_config_json(path, asset_root));
   }, py::arg("path"), py::arg("asset_root") = "", "kagec resolve: the canonical Spec as JSON text.");

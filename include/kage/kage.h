@@ -70,6 +70,10 @@ struct InfoFieldDesc {
 /// Every info field, in runtime/info_fields.def order; `count` receives their number.
 const InfoFieldDesc* info_fields(int32_t* count);
 
+/// The text in every error about an action outside 0..7 (from step, reset, synchronize or
+/// pending_error), by which a caller can tell that error from the others.
+const char* action_range_text();
+
 /// Actions for step(): num_envs() integers, element env * stride of `data`. Values outside 0..7 are an
 /// error: host arrays are checked before the step; device arrays are checked by the step kernel and
 /// reported by a later call (pending_error), since checking at once would wait for the device.

@@ -12,7 +12,7 @@ import numpy as np
 from kage import _kage
 
 _DLPACK_CPU, _DLPACK_CUDA, _DLPACK_CUDA_HOST, _DLPACK_CUDA_MANAGED = 1, 2, 3, 13
-_RANGE = "an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump)"
+_RANGE = _kage.action_range_text()
 
 
 def submit(handle: "_kage.Env", actions) -> None:

@@ -96,16 +96,6 @@ int32_t visual_state_extent(const VisualParams& p, const AssetView& a) {
   return static_cast<int32_t>(offsetof(VisualState, npc_x));
 }
 
-size_t device_state_bytes_per_env(const LatentParams& lp) {
-  size_t info_bytes = 0;
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) info_bytes += sizeof(ctype);
-#include "runtime/info_fields.def"
-#undef KAGE_INFO_FIELD
-  const size_t stride = static_cast<size_t>(segment_stride_bytes(layout_segment_count(lp)));
-  return sizeof(uint64_t) + 2 * (sizeof(LatentState) + stride + sizeof(VisualState) + info_bytes) + sizeof(int32_t) +
-         sizeof(float) + 4;
-}
-
 std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const LatentParams& lp,
                                                const VisualParams& vp, const AssetView& host_assets, int32_t num_envs,
                                                std::string* error) {
@@ -323,15 +313,12 @@ bool DeviceBatch::step_device_actions(std::string* error) { return launch_step(e
 
 bool DeviceBatch::step_no_render(std::string* error) { return launch_step(envs_.actions, false, error); }
 
-std::string DeviceBatch::take_action_error() {
+std::optional<ActionError> DeviceBatch::take_action_error() {
   volatile ActionError* e = action_error_;
-  if (e->state != 2u) return {};
-  const std::string text = "the actions of step " + std::to_string(e->step) + " held " + std::to_string(e->value) +
-                           " for environment " + std::to_string(e->env) +
-                           ": an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump); that step ran "
-                           "with the value masked to its low 3 bits";
+  if (e->state != 2u) return std::nullopt;
+  const ActionError reported{2u, e->env, e->value, e->step};
   e->state = 0u;
-  return text;
+  return reported;
 }
 
 bool DeviceBatch::synchronize(std::string* error) const {
@@ -385,24 +372,37 @@ std::vector<StateSection> state_sections(const DeviceEnvs& e, const BatchStateLa
 
 }  // namespace
 
-bool DeviceBatch::save_state(const std::string& spec_hash, std::vector<uint8_t>* out, std::string* error) const {
+bool DeviceBatch::copy_state(uint8_t* blob, bool to_host, std::string* error) const {
   const size_t n = static_cast<size_t>(envs_.num_envs);
   const BatchStateLayout l(n, static_cast<size_t>(segment_count_));
-  out->assign(l.total, 0);
-  write_batch_state_header(out->data(), envs_.num_envs, segment_count_, spec_hash);
   for (const StateSection& s : state_sections(envs_, l, static_cast<size_t>(segment_count_))) {
     CUDA_MEMCPY2D c{};
-    c.srcMemoryType = CU_MEMORYTYPE_DEVICE;
-    c.srcDevice = s.device;
-    c.srcPitch = s.pitch;
-    c.dstMemoryType = CU_MEMORYTYPE_HOST;
-    c.dstHost = out->data() + s.blob;
-    c.dstPitch = s.bytes_per_env;
+    if (to_host) {
+      c.srcMemoryType = CU_MEMORYTYPE_DEVICE;
+      c.srcDevice = s.device;
+      c.srcPitch = s.pitch;
+      c.dstMemoryType = CU_MEMORYTYPE_HOST;
+      c.dstHost = blob + s.blob;
+      c.dstPitch = s.bytes_per_env;
+    } else {
+      c.srcMemoryType = CU_MEMORYTYPE_HOST;
+      c.srcHost = blob + s.blob;
+      c.srcPitch = s.bytes_per_env;
+      c.dstMemoryType = CU_MEMORYTYPE_DEVICE;
+      c.dstDevice = s.device;
+      c.dstPitch = s.pitch;
+    }
     c.WidthInBytes = s.bytes_per_env;
     c.Height = n;
-    if (!check(cuMemcpy2DAsync(&c, stream_), "cuMemcpy2DAsync(save state)", error)) return false;
+    if (!check(cuMemcpy2DAsync(&c, stream_), "cuMemcpy2DAsync(state)", error)) return false;
   }
-  return synchronize(error);
+  return true;
+}
+
+bool DeviceBatch::save_state(const std::string& spec_hash, std::vector<uint8_t>* out, std::string* error) const {
+  out->assign(BatchStateLayout(static_cast<size_t>(envs_.num_envs), static_cast<size_t>(segment_count_)).total, 0);
+  write_batch_state_header(out->data(), envs_.num_envs, segment_count_, spec_hash);
+  return copy_state(out->data(), true, error) && synchronize(error);
 }
 
 bool DeviceBatch::load_state(const uint8_t* data, size_t size, const std::string& spec_hash, std::string* error) {
@@ -411,20 +411,10 @@ bool DeviceBatch::load_state(const uint8_t* data, size_t size, const std::string
     *error = problem;
     return false;
   }
+  // The blob is read, never written: copy_state takes a mutable pointer for both directions.
+  if (!copy_state(const_cast<uint8_t*>(data), false, error)) return false;
   const size_t n = static_cast<size_t>(envs_.num_envs);
   const BatchStateLayout l(n, static_cast<size_t>(segment_count_));
-  for (const StateSection& s : state_sections(envs_, l, static_cast<size_t>(segment_count_))) {
-    CUDA_MEMCPY2D c{};
-    c.srcMemoryType = CU_MEMORYTYPE_HOST;
-    c.srcHost = data + s.blob;
-    c.srcPitch = s.bytes_per_env;
-    c.dstMemoryType = CU_MEMORYTYPE_DEVICE;
-    c.dstDevice = s.device;
-    c.dstPitch = s.pitch;
-    c.WidthInBytes = s.bytes_per_env;
-    c.Height = n;
-    if (!check(cuMemcpy2DAsync(&c, stream_), "cuMemcpy2DAsync(load state)", error)) return false;
-  }
   std::memcpy(seeds_.data(), data + l.seeds, n * sizeof(uint64_t));
   // Frames are a pure function of the state: render them again instead of saving them. The copies
   // read pageable host memory, so they are complete when this returns.

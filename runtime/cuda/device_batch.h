@@ -21,10 +21,6 @@
 
 namespace kage {
 
-/// Bytes of one environment's device state besides the observations: latent state, layout, visual
-/// state, seed, action, reward, flags, info, and the final state and info kept by autoreset.
-size_t device_state_bytes_per_env(const LatentParams& lp);
-
 /// Leading bytes of VisualState that a step or a render of this config can read or write: the entity
 /// arrays of disabled entity kinds are never touched, so the rendering blocks copy only this prefix.
 int32_t visual_state_extent(const VisualParams& vp, const AssetView& assets);
@@ -68,9 +64,9 @@ class DeviceBatch {
   bool step_no_render(std::string* error);
   /// Fills actions() with uniform random actions in [0, 8) for step t, on the device.
   bool sample_actions(uint64_t seed, uint32_t t, std::string* error);
-  /// The first out-of-range device action a finished step reported ("" if none), then forgets it. Reads
-  /// host-mapped memory: no synchronisation, so a report arrives once its step has run.
-  std::string take_action_error();
+  /// The first out-of-range device action a finished step reported (none if none), then forgets it.
+  /// Reads host-mapped memory: no synchronisation, so a report arrives once its step has run.
+  std::optional<ActionError> take_action_error();
 
   int32_t size() const { return envs_.num_envs; }
   /// Device pointers: [N][H][W][3] uint8 observations, [N] float reward, [N] uint8 flags.
@@ -104,6 +100,8 @@ class DeviceBatch {
   /// Launches the render kernel: frames_per_block_ environments per block.
   bool launch_render(std::string* error);
   bool launch_step(const ActionSource& source, bool render, std::string* error);
+  /// Queues the copies between the saved-state sections of `blob` and the device (to_host: download).
+  bool copy_state(uint8_t* blob, bool to_host, std::string* error) const;
 
   DeviceEnvs envs_{};
   CUstream stream_ = nullptr;
