@@ -22,7 +22,7 @@ import statistics
 import subprocess
 import sys
 import time
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Tuple
 
 import torch
 
@@ -66,11 +66,10 @@ class RunDir:
         return os.path.exists(os.path.join(self.path, "summary.json"))
 
     @classmethod
-    def open(cls, args, labels: List[str]) -> "RunDir":
-        """The run directory of `args`: created with its description, or checked against it."""
-        from kage.train import eval_paths
+    def open(cls, args, configs: List[Tuple[str, str]]) -> "RunDir":
+        """The run directory of `args`, which trains and evaluates on `configs` ((label, path): "train"
+        first): created with its description, or checked against it."""
         path = args.out or default_dir(args)
-        configs = [("train", args.train_config_path)] + list(zip(labels, eval_paths(args)))
         specs = {}
         for label, config in configs:
             if not os.path.exists(config):

@@ -32,7 +32,7 @@ import os
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Tuple
 
 import torch
 
@@ -174,6 +174,11 @@ def eval_paths(args: Args) -> List[str]:
     return [args.eval_config_path] if args.eval_config_path else list(args.eval_config_paths)
 
 
+def configs_of(args: Args) -> List[Tuple[str, str]]:
+    """(label, path) of the configs a run evaluates on: "train" first, then the eval configs."""
+    return [("train", args.train_config_path)] + list(zip(eval_labels(args), eval_paths(args)))
+
+
 def eval_labels(args: Args) -> List[str]:
     """Labels of the eval configs: given, or the file base name with spaces as underscores (§3.5)."""
     labels = args.eval_config_labels or [os.path.basename(p.rstrip("/")).replace(" ", "_") for p in eval_paths(args)]
@@ -257,12 +262,12 @@ class Run:
 
 
 def open_run(args: Args, threads: int) -> Run:
-    run_dir = rundir.RunDir.open(args, labels=eval_labels(args))
+    run_dir = rundir.RunDir.open(args, configs_of(args))
     env = kage.make_vec(args.train_config_path, args.num_envs, device=args.device, seed=args.seed,
                         asset_root=args.asset_root, threads=threads)
     eval_envs = {}
     if args.run_eval_every > 0 and args.eval_episodes > 0 and args.eval_num_envs > 0:
-        for label, path in [("train", args.train_config_path)] + list(zip(eval_labels(args), eval_paths(args))):
+        for label, path in configs_of(args):
             eval_envs[label] = kage.make_vec(path, args.eval_num_envs, device=args.device, asset_root=args.asset_root,
                                              threads=threads)
     return Run(args, run_dir, env, eval_envs, run_dir.specs)
@@ -419,7 +424,10 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
 
         for step in range(T):  # §2.5 step 1
             with timer("forward"):
-                obs[step] = observe()
+                if stack:
+                    obs[step] = stack.stack
+                else:
+                    torch.stack(frames, out=obs[step])  # the runtime's frames straight into the rollout buffer
                 dones[step] = next_done
                 action, logprob, value = rollout(obs[step], noise[:, step])
                 values[step], actions[step], logprobs[step] = value, action, logprob
@@ -581,7 +589,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     pack = parsed if isinstance(parsed, list) else [parsed]
     unfinished = []
     for args in pack:
-        run_dir = rundir.RunDir.open(args, labels=eval_labels(args))
+        run_dir = rundir.RunDir.open(args, configs_of(args))
         if run_dir.finished:
             print(f"kage.train: {run_dir.path} is finished (summary.json); nothing to do", file=sys.stderr)
         else:
