@@ -72,8 +72,13 @@ class Agent(nn.Module):
         x = F.relu(self.conv3(x))
         x = x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
         hidden = F.relu(torch.baddbmm(self.fc_bias, x, self.fc_weight))
-        logits = torch.baddbmm(self.actor_bias, hidden, self.actor_weight)
-        value = torch.baddbmm(self.critic_bias, hidden, self.critic_weight).squeeze(-1)
+        # The heads always in float32, even under --bf16: values reach thousands (an untrained episode
+        # returns about -3,900), where bfloat16's spacing is 16, more than a step's reward; rounded values
+        # would bury the advantages in noise.
+        with torch.autocast(hidden.device.type, enabled=False):
+            hidden = hidden.float()
+            logits = torch.baddbmm(self.actor_bias, hidden, self.actor_weight)
+            value = torch.baddbmm(self.critic_bias, hidden, self.critic_weight).squeeze(-1)
         return logits, value
 
     def _input(self, frames: torch.Tensor) -> torch.Tensor:

@@ -38,6 +38,7 @@ import torch
 
 import kage
 from kage import rundir
+from kage.stop import StopRequest
 from kage.agent import Agent, autocast, entropy_of, sample_gumbel_max
 from kage.counter_random import CounterRandom
 from kage.evaluation import METRICS, EpisodeMetrics, evaluation_rows
@@ -298,10 +299,13 @@ class NoTimer:
 
 # ---- the training loop (§2.5) ----
 
-def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> List[Run]:
+def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
+          stop: Optional[StopRequest] = None) -> List[Run]:
     """Trains the runs of `pack` together (one for a lone run) to the end, or `stop_after` iterations past
-    where they start (kage.bench speed). Resumes each run from its checkpoint if it has one."""
+    where they start (kage.bench speed). Resumes each run from its checkpoint if it has one. Once `stop` is
+    requested (a signal), checkpoints after the running iteration and exits."""
     args = check_pack(pack)
+    stop = stop or StopRequest("kage.train", "")
     timer = timer or NoTimer()
     if args.device == "cuda" and not torch.cuda.is_available():
         raise SystemExit("kage.train: --device cuda, but torch sees no GPU: use --device cpu")
@@ -512,10 +516,14 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None) -> Lis
             if eval_rows:
                 run.history.append(run.dir.log(eval_rows[k]))
         if (args.save_checkpoint_every > 0 and iteration % args.save_checkpoint_every == 0) or \
-                iteration == args.num_iterations:  # §2.5 step 7, and at the end
+                iteration == args.num_iterations or stop.requested:  # §2.5 step 7, at the end, and when asked
             save_checkpoints(iteration)
         progress.update(iteration, global_step * K, {"charts/SPS": global_step * K / train_seconds},
                         eval_rows[0] if eval_rows else None)
+        if stop.requested and iteration < last_iteration:
+            print(f"kage.train: stopped after iteration {iteration} of {args.num_iterations}, checkpointed; "
+                  "run the same command again to resume", file=sys.stderr, flush=True)
+            raise SystemExit(stop.exit_code)
 
     if last_iteration == args.num_iterations:
         for run in runs:
@@ -595,7 +603,8 @@ def main(argv: Optional[List[str]] = None) -> int:
         else:
             unfinished.append(args)
     if unfinished:
-        train(unfinished)
+        with StopRequest("kage.train", "finishing this iteration, then checkpointing and exiting") as stop:
+            train(unfinished, stop=stop)
     return 0
 
 

@@ -21,6 +21,7 @@ import difflib
 import json
 import os
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -29,6 +30,7 @@ from typing import Dict, List, Optional
 from kage import _kage
 from kage.errors import ConfigError
 from kage.files import atomic_write, write_json
+from kage.stop import ForwardSignals
 
 
 @dataclasses.dataclass
@@ -198,6 +200,40 @@ def last_progress(metrics_path: str):
     return 0, None
 
 
+def train_packs(out: str, pack_size: int, trainer_args: List[str], pending: List[tuple], display: Display,
+                signals: ForwardSignals) -> List[str]:
+    """Trains the pending runs pack after pack, each pack in a `python3 -m kage.train` process; returns the
+    labels of the failed runs. A signal is passed on to the running process and ends the loop."""
+    failures = []
+    for index, pack in enumerate(packs_of(pending, pack_size)):
+        if signals.signum:
+            break
+        labels = [f"{u.name} seed {s}" for u, s, _ in pack]
+        if len(pack) == 1:
+            log_path = os.path.join(pack[0][2], "train.log")
+            command = train_flags(*pack[0], trainer_args)
+        else:
+            log_path = os.path.join(out, "packs", f"pack_{index}.log")
+            command = ["--pack", write_pack_file(out, index, pack, trainer_args)]
+        label = labels[0] if len(pack) == 1 else f"pack of {len(pack)} ({labels[0]}, ...)"
+        with open(log_path, "ab") as log:
+            signals.child = subprocess.Popen([sys.executable, "-m", "kage.train", *command], stdout=log, stderr=log,
+                                             start_new_session=True)
+            while signals.child.poll() is None:
+                display.running(label, os.path.join(pack[0][2], "metrics.jsonl"), len(pack))
+                time.sleep(1.0)
+        returncode = signals.child.returncode
+        for one in labels:
+            if returncode == 0:
+                display.finished(one, "done")
+            elif signals.signum:
+                display.finished(one, "stopped (checkpointed)")
+            else:
+                failures.append(one)
+                display.finished(one, f"FAILED (exit {returncode}); see {log_path}")
+    return failures
+
+
 def main(argv: List[str]) -> int:
     parser = argparse.ArgumentParser(prog="python3 -m kage.bench run", description=__doc__.split("\n\n")[0],
                                      epilog="Any other flag is a trainer flag (python3 -m kage.train --help).")
@@ -239,27 +275,12 @@ def main(argv: List[str]) -> int:
         else:
             os.makedirs(run_dir, exist_ok=True)
             pending.append((unit, seed, run_dir))
-    failures = []
-    for index, pack in enumerate(packs_of(pending, args.pack)):
-        labels = [f"{u.name} seed {s}" for u, s, _ in pack]
-        if len(pack) == 1:
-            log_path = os.path.join(pack[0][2], "train.log")
-            command = train_flags(*pack[0], trainer_args)
-        else:
-            log_path = os.path.join(args.out, "packs", f"pack_{index}.log")
-            command = ["--pack", write_pack_file(args.out, index, pack, trainer_args)]
-        label = labels[0] if len(pack) == 1 else f"pack of {len(pack)} ({labels[0]}, ...)"
-        with open(log_path, "ab") as log:
-            child = subprocess.Popen([sys.executable, "-m", "kage.train", *command], stdout=log, stderr=log)
-            while child.poll() is None:
-                display.running(label, os.path.join(pack[0][2], "metrics.jsonl"), len(pack))
-                time.sleep(1.0)
-        for one in labels:
-            if child.returncode == 0:
-                display.finished(one, "done")
-            else:
-                failures.append(one)
-                display.finished(one, f"FAILED (exit {child.returncode}); see {log_path}")
+    with ForwardSignals() as signals:
+        failures = train_packs(args.out, args.pack, trainer_args, pending, display, signals)
+    if signals.signum:
+        print(f"kage.bench run: stopped by {signal.Signals(signals.signum).name}; the runs keep their checkpoints: "
+              "run the same command again to resume", file=sys.stderr)
+        return 128 + signals.signum
     if failures:
         print(f"kage.bench run: {len(failures)} run(s) failed: {', '.join(failures)}; rerun to resume them",
               file=sys.stderr)

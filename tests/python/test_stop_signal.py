@@ -1,0 +1,60 @@
+"""SIGTERM (a scheduler's preemption, `timeout`) stops a run without losing work: kage.bench run passes it
+to its training process, which finishes the iteration, checkpoints it (even with periodic checkpoints off)
+and exits 143; the same command then resumes, and the run ends exactly as an uninterrupted one."""
+import json
+import signal
+import subprocess
+import sys
+import time
+
+from support import ROOT
+
+TINY = ["--total-timesteps", "512", "--num-envs", "2", "--num-steps", "32", "--num-minibatches", "2",
+        "--update-epochs", "1", "--run-eval-every", "4", "--eval-episodes", "2", "--eval-num-envs", "2",
+        "--device", "cpu", "--threads", "1", "--save-checkpoint-every", "0"]
+TIMING = {"charts/SPS", "charts/SPS_update", "seconds"}
+
+
+def bench_run(out):
+    return subprocess.Popen([sys.executable, "-m", "kage.bench", "run", "suites/kage_bench.yaml", "--pairs",
+                             "background/1", "--seeds", "1", "--out", str(out), *TINY],
+                            cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def rows(run_dir):
+    with open(run_dir / "metrics.jsonl") as f:
+        return [{k: v for k, v in json.loads(line).items() if k not in TIMING} for line in f]
+
+
+def train_rows(run_dir):
+    if not (run_dir / "metrics.jsonl").exists():
+        return 0
+    return sum(1 for line in open(run_dir / "metrics.jsonl") if '"kind": "train"' in line)
+
+
+def test_sigterm_checkpoints_and_resumes(tmp_path):
+    whole, stopped = tmp_path / "whole", tmp_path / "stopped"
+    first = bench_run(whole)
+    assert first.wait(timeout=900) == 0, first.stdout.read()
+
+    run_dir = stopped / "runs" / "background" / "1" / "seed_1"
+    child = bench_run(stopped)
+    deadline = time.time() + 600
+    while time.time() < deadline and child.poll() is None and train_rows(run_dir) < 2:
+        time.sleep(0.05)
+    assert child.poll() is None, "the run ended before it could be stopped"
+    child.send_signal(signal.SIGTERM)
+    output = child.communicate(timeout=300)[0]
+    assert child.returncode == 128 + signal.SIGTERM, output
+    assert "stopped by SIGTERM" in output and "run the same command again to resume" in output
+    log = (run_dir / "train.log").read_text()
+    assert "kage.train: stopped after iteration" in log
+    checkpointed = json.loads((run_dir / "checkpoints" / "latest.json").read_text())["iteration"]
+    assert checkpointed == train_rows(run_dir) >= 2  # no finished iteration lost
+    assert checkpointed < 8 and not (run_dir / "summary.json").exists()
+
+    resumed = bench_run(stopped)
+    output = resumed.communicate(timeout=900)[0]
+    assert resumed.returncode == 0, output
+    assert f"after iteration {checkpointed}" in (run_dir / "train.log").read_text()
+    assert rows(run_dir) == rows(whole / "runs" / "background" / "1" / "seed_1")
