@@ -4,14 +4,14 @@
 # (`python3 -m kage.bench run --pack`). A call trains until BUDGET seconds (default 540, the build
 # included) have passed, then SIGTERM makes the trainer checkpoint and exit; call again on the warm machine
 # and it resumes from the checkpoints on that machine's disk. Once every run is finished, the report is
-# written. Logs, metrics and the report (no checkpoints) come back under $OUT/paper-gaps. Carry [".deps"]:
+# written. Logs, metrics and the report (no checkpoints) come back under $OUT. Carry [".deps"]:
 #   BUDGET=540 bash bench/paper_gaps_device.sh
 set -uo pipefail
 source bench/device_build.sh
 dir=/tmp/kage-paper-gaps
 seeds=${SEEDS:-1-2}
 runs=$((2 * ($(seq -s ' ' ${seeds/-/ } | wc -w))))
-flags=(--device cuda --bf16 --channels-last --fused-input --cuda-graph)
+flags=(--device cuda --bf16 --channels-last --fused-input)
 timeout -s TERM --kill-after=120 $((${BUDGET:-540} - SECONDS)) \
   python3 -m kage.bench run suites/kage_bench.yaml --pairs background/1 agent_appearance/1 --seeds "$seeds" \
   --pack "$runs" --out "$dir" "${flags[@]}"
@@ -20,5 +20,11 @@ tail -3 "$dir"/packs/*.log
 if [ "$(find "$dir/runs" -name summary.json | wc -l)" -eq "$runs" ]; then
   python3 -m kage.bench report "$dir"
 fi
-mkdir -p "$OUT/paper-gaps"
-tar -C "$dir" --exclude=checkpoints -cf - . | tar -C "$OUT/paper-gaps" -xf -
+# What comes back (the device tool returns folders 3 deep): the report, the logs, each run's files.
+cp -r "$dir/report" "$OUT/" 2>/dev/null
+cp "$dir"/packs/*.log "$dir/bench.json" "$OUT/"
+for run in "$dir"/runs/*/*/seed_*; do
+  name=$(realpath --relative-to="$dir/runs" "$run" | tr / _)
+  mkdir -p "$OUT/runs/$name"
+  cp "$run"/*.json "$run"/metrics.jsonl "$OUT/runs/$name/" 2>/dev/null
+done
