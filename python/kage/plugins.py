@@ -15,6 +15,7 @@ evaluation's observations): obs is uint8 [K, B, H, W, C], uniform(shape) returns
 uniforms in (0, 1) from each run's own counter-based stream (the same numbers alone, packed or resumed);
 it returns uint8 frames of the same shape.
 """
+import difflib
 import importlib
 import inspect
 from typing import Callable, List, Optional, Sequence
@@ -40,8 +41,9 @@ def load(reference: str, flag: str) -> Callable:
         names = [n for n, v in vars(module).items() if callable(v) and not n.startswith("_")
                  and getattr(v, "__module__", None) == module.__name__]
         what = "has no" if found is None else "has a non-callable"
-        raise SystemExit(f"kage.train: {flag} {reference}: {module.__file__} {what} '{attribute}'; it defines "
-                         f"{', '.join(names) or 'no functions'}")
+        close = difflib.get_close_matches(attribute, names, n=1)
+        hint = f"did you mean '{close[0]}'?" if close else f"it defines {', '.join(names) or 'no functions'}"
+        raise SystemExit(f"kage.train: {flag} {reference}: {module.__file__} {what} '{attribute}'; {hint}")
     return found
 
 

@@ -18,8 +18,10 @@ def test_references_are_checked_with_their_fix():
         plugins.load("kage.agent.nature_cnn", "--agent")
     with pytest.raises(SystemExit, match="cannot import 'no_such_module'.*PYTHONPATH"):
         plugins.load("no_such_module:make", "--agent")
-    with pytest.raises(SystemExit, match="has no 'nature_cnnn'; it defines .*nature_cnn"):
+    with pytest.raises(SystemExit, match="has no 'nature_cnnn'; did you mean 'nature_cnn'"):
         plugins.load("kage.agent:nature_cnnn", "--agent")
+    with pytest.raises(SystemExit, match="has no 'xyz'; it defines TinyNet, make, wrong_shape"):
+        plugins.load("lone_agent:xyz", "--agent")
     with pytest.raises(SystemExit, match=r"must take \(obs, uniform\)"):
         plugins.load_augment("math:sqrt")
 
