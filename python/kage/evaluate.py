@@ -54,10 +54,9 @@ def load_policy(file: str, device: str):
         state = torch.load(file, map_location="cpu", weights_only=False)  # a kage.train checkpoint
     except Exception as e:  # torch raises many kinds on a damaged or foreign file
         fail(f"{file} is not a readable kage.train checkpoint ({type(e).__name__}: {e})")
-    spec = state.get("agent_spec") if isinstance(state, dict) else None
-    if spec is None:
-        fail(f"{file} does not name its network (written by an older kage.train): resume the run once with this "
-             "version (the same kage.train command) to rewrite its checkpoint")
+    if not (isinstance(state, dict) and "agent" in state and "iteration" in state):
+        fail(f"{file} is not a kage.train checkpoint (no parameters and iteration)")
+    spec = state.get("agent_spec") or spec_from_run_dir(file)
     agent = plugins.build_agent(spec["agent"], spec["observation_shape"], spec["num_actions"], [spec["seed"]], device)
     with torch.no_grad():
         for name, p in agent.named_parameters():
@@ -67,6 +66,24 @@ def load_policy(file: str, device: str):
             agent.run_view(p)[0].copy_(state["agent"][name])
     agent.eval()
     return agent, spec, state
+
+
+def spec_from_run_dir(file: str) -> dict:
+    """The agent_spec of a checkpoint written before checkpoints carried one (the baseline's network then),
+    from its run directory: run.json's arguments and the train config's resolved Spec."""
+    run_dir = os.path.dirname(os.path.dirname(os.path.abspath(file)))
+    try:
+        with open(os.path.join(run_dir, "run.json")) as f:
+            args = json.load(f)["args"]
+        with open(os.path.join(run_dir, "configs", "train.json")) as f:
+            config = json.load(f)["config"]
+    except (OSError, ValueError, KeyError) as e:
+        fail(f"{file} does not name its network, and its run directory {run_dir} cannot tell it ({e}): give the "
+             "checkpoint inside its kage.train run directory")
+    channels = 3 * (4 if args["use_frame_stack"] else 1)
+    return {"agent": args.get("agent", plugins.BASELINE_AGENT), "num_actions": 8,  # KAGE's 3 action bits
+            "observation_shape": [config["H"], config["W"], channels], "use_frame_stack": args["use_frame_stack"],
+            "seed": args["seed"]}
 
 
 def open_env(config: str, num_envs: int, spec: dict, file: str, options) -> "kage.VecEnv":

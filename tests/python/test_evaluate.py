@@ -10,6 +10,7 @@ import subprocess
 import sys
 
 import pytest
+import torch
 from PIL import Image
 
 import counting_augment
@@ -122,6 +123,23 @@ def test_evaluate_configs_reproduces_the_last_evaluation(run, tmp_path):
     assert int(row["episodes"]) >= 2 and float(row["length"]) == EPISODE_LENGTH
     assert "| noisy_short.yaml |" not in (tmp_path / "eval" / "configs.md").read_text()  # the path is shown
     assert NOISY_SKELETON in (tmp_path / "eval" / "configs.md").read_text()
+
+
+def test_checkpoint_without_agent_spec_is_rebuilt_from_its_run_directory(run, tmp_path):
+    out, _ = run
+    older = tmp_path / "older"
+    for name in ("run.json", "configs/train.json"):
+        (older / name).parent.mkdir(parents=True, exist_ok=True)
+        (older / name).write_bytes((out / name).read_bytes())
+    state = torch.load(out / "checkpoints" / "latest.pt", weights_only=False)
+    del state["agent_spec"]  # as kage.train wrote checkpoints before --agent
+    (older / "checkpoints").mkdir()
+    torch.save(state, older / "checkpoints" / "latest.pt")
+    done = evaluate(str(older), "--config", NOISY_SKELETON, "--out", str(tmp_path / "eval"))
+    assert done.returncode == 0, done.stderr
+    with open(tmp_path / "eval" / "configs.csv") as f:
+        (row,) = list(csv.DictReader(f))
+    assert float(row["return"]) == pytest.approx(evaluations(out)[-1]["evals"][LABEL]["return"], rel=1e-6)
 
 
 def test_evaluate_suite_writes_the_report_tables(run, tmp_path):
