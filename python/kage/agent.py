@@ -27,7 +27,8 @@ class Agent(nn.Module):
     linear heads each (§1.2). Run k owns the k-th group of every grouped convolution and the k-th matrix of
     every batched linear layer, so one pass per layer evaluates all K."""
 
-    def __init__(self, seeds: List[int], channels: int = 3, height: int = 128, width: int = 128, device="cpu"):
+    def __init__(self, seeds: List[int], channels: int = 3, height: int = 128, width: int = 128, device="cpu",
+                 num_actions: int = 8):
         super().__init__()
         k = self.runs = len(seeds)
         self.conv1 = nn.Conv2d(k * channels, k * 32, 8, stride=4, groups=k, device=device)
@@ -37,8 +38,8 @@ class Agent(nn.Module):
         self.flat = 64 * conv_h * conv_w
         self.fc_weight = nn.Parameter(torch.empty(k, self.flat, 512, device=device))
         self.fc_bias = nn.Parameter(torch.zeros(k, 1, 512, device=device))
-        self.actor_weight = nn.Parameter(torch.empty(k, 512, 8, device=device))
-        self.actor_bias = nn.Parameter(torch.zeros(k, 1, 8, device=device))
+        self.actor_weight = nn.Parameter(torch.empty(k, 512, num_actions, device=device))
+        self.actor_bias = nn.Parameter(torch.zeros(k, 1, num_actions, device=device))
         self.critic_weight = nn.Parameter(torch.empty(k, 512, 1, device=device))
         self.critic_bias = nn.Parameter(torch.zeros(k, 1, 1, device=device))
         self.input_dtype = torch.float32  # bfloat16 under --bf16
@@ -61,7 +62,7 @@ class Agent(nn.Module):
             weight[run].copy_(orthogonal(weight.shape[2], weight.shape[1], gain, weight.device).T)
 
     def forward(self, obs: torch.Tensor):
-        """uint8 [K, B, H, W, C] frames -> logits [K, B, 8] and values [K, B]. The first operation is the
+        """uint8 [K, B, H, W, C] frames -> logits [K, B, A] and values [K, B]. The first operation is the
         conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups."""
         k, b, h, w, c = obs.shape
         if self.space_to_depth:
@@ -112,6 +113,15 @@ class Agent(nn.Module):
         return tensor.unflatten(0, (self.runs, -1))
 
 
+def nature_cnn(observation_shape, num_actions: int, seeds: List[int], device) -> Agent:
+    """The baseline's network as a kage.plugins agent factory (the default of --agent)."""
+    height, width, channels = observation_shape
+    return Agent(seeds, channels, height, width, device, num_actions)
+
+
+nature_cnn.packable = True
+
+
 def sample_gumbel_max(logits: torch.Tensor, uniform: torch.Tensor):
     """Categorical sampling by the Gumbel-max trick (§1.4): the action and its log-probability."""
     action = torch.argmax(logits - torch.log(-torch.log(uniform)), dim=-1)
@@ -123,3 +133,43 @@ def entropy_of(logits: torch.Tensor) -> torch.Tensor:
     """Entropy from log-softmax logits clipped at the smallest float32, so p log p is never 0 * -inf."""
     log_p = torch.log_softmax(logits, dim=-1).clamp(min=torch.finfo(logits.dtype).min)
     return -(log_p.exp() * log_p).sum(-1)
+
+
+class RolloutPolicy:
+    """The rollout's policy step: forward, Gumbel-max sampling (§1.4) with the given uniforms, the
+    log-probability and the value. Under --cuda-graph it is captured once and replayed each step from
+    static input buffers."""
+
+    def __init__(self, policy, args, obs_shape, num_actions: int, device):
+        self.policy, self.args = policy, args
+        self.graph = None
+        if args.cuda_graph:
+            self.obs = torch.zeros(obs_shape, dtype=torch.uint8, device=device)
+            self.uniform = torch.full((*obs_shape[:2], num_actions), 0.5, device=device)
+            side = torch.cuda.Stream()
+            side.wait_stream(torch.cuda.current_stream())
+            with torch.cuda.stream(side), torch.no_grad():
+                for _ in range(3):  # warm-up: cuDNN picks its algorithms outside the capture
+                    self._step()
+            torch.cuda.current_stream().wait_stream(side)
+            self.graph = torch.cuda.CUDAGraph()
+            with torch.cuda.graph(self.graph), torch.no_grad():
+                self.outputs = self._step()
+
+    def _step(self):
+        with autocast(self.args.bf16):
+            logits, value = self.policy(self.obs)
+        action, logprob = sample_gumbel_max(logits.float(), self.uniform)
+        return action, logprob, value.float()
+
+    @torch.no_grad()
+    def __call__(self, obs: torch.Tensor, uniform: torch.Tensor):
+        """obs [K, N, H, W, C] uint8, uniform [K, N, A] in (0, 1) -> action, log-probability, value [K, N]."""
+        if self.graph is None:
+            self.obs, self.uniform = obs, uniform
+            return self._step()
+        self.obs.copy_(obs)
+        self.uniform.copy_(uniform)
+        self.graph.replay()
+        return self.outputs
+

@@ -48,7 +48,7 @@ def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int
     after the waves (and steps on, a wave at a time, if one fell short)."""
     device = next(agent.parameters()).device
     flat_envs = [e for run in envs for e in run]
-    configs, n = len(envs[0]), flat_envs[0].num_envs
+    configs, n, num_actions = len(envs[0]), flat_envs[0].num_envs, flat_envs[0].single_action_space.n
     random = CounterRandom([s for run in seeds for s in run], device)
     counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
     infos = []
@@ -60,13 +60,13 @@ def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int
     chunk = -(-episodes // n) * episode_length
     records, waves = [], 0
     while True:
-        noise = random.uniform(0, counter.fill_(waves), (chunk, n, 8))  # each evaluation's draws for the chunk
+        noise = random.uniform(0, counter.fill_(waves), (chunk, n, num_actions))  # each evaluation's draws for the chunk
         waves += 1
         for step in range(chunk):
             obs = stack.stack if stack else torch.stack(frames)             # [K * C, E, H, W, ch]
             with autocast(args.bf16):
                 logits, _ = agent(obs.view(len(envs), configs * n, *obs.shape[2:]))
-            logits = logits.float().view(len(flat_envs), n, 8)
+            logits = logits.float().view(len(flat_envs), n, num_actions)
             # QUIRK: sampled, not greedy (Gumbel-max: an exact categorical sampler with no host check).
             actions = logits.argmax(-1) if args.eval_greedy else sample_gumbel_max(logits, noise[:, step])[0]
             for env, action in zip(flat_envs, actions):

@@ -30,6 +30,8 @@ from kage import _kage
 from kage.files import atomic_write, safe, write_json
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
+# Arguments added since runs were first written, with the value that means what a run without them did.
+_ADDED_ARGUMENTS = {"agent": "kage.agent:nature_cnn", "augment": None, "video_every": 0}
 
 
 def code_version() -> str:
@@ -220,9 +222,10 @@ def check_same_run(path: str, previous: dict, args: dict, configs: dict) -> None
                 f"kage.train: config '{now['path']}' ({label}) changed since {path} started (spec "
                 f"{before['spec_sha256'][:12]} then, {now['spec_sha256'][:12]} now): restore it, or start a new run "
                 "with another --out")
-    changed = sorted(k for k in args if k not in _RESUMABLE_CHANGES and previous["args"].get(k) != args[k])
+    before = dict(_ADDED_ARGUMENTS, **previous["args"])
+    changed = sorted(k for k in args if k not in _RESUMABLE_CHANGES and before.get(k) != args[k])
     if changed:
-        details = ", ".join(f"{k}: {previous['args'].get(k)!r} then, {args[k]!r} now" for k in changed)
+        details = ", ".join(f"{k}: {before.get(k)!r} then, {args[k]!r} now" for k in changed)
         raise SystemExit(f"kage.train: {path} was started with other arguments ({details}); "
                          "rerun with the original ones to resume, or use another --out")
 

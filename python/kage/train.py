@@ -12,7 +12,11 @@ one makes sense:
 - evaluation samples its actions: --eval-greedy takes the most likely action instead;
 - `success` is recomputed with a strict `>` at the terminal state, and the plots labelled "success rate"
   show `success_once`: both are logged.
-Not offered: --target-kl (declared and never read by the original), videos, Weights & Biases.
+Not offered: --target-kl (declared and never read by the original), Weights & Biases.
+
+Your own agent: --agent module:factory builds the network, --augment module:fn transforms the update's
+minibatches (kage.plugins); the rest of the protocol is the same for every agent. Videos: kage.video;
+TensorBoard scalars under the original's tags, where tensorboard is importable: kage.tensorboard_log.
 
 Packing: the loop trains K runs at once (K = 1 for a lone run; `kage.bench run --pack K`). Each run has its
 own parameters, optimizer state, random streams, environments and run directory, and follows the same
@@ -37,14 +41,15 @@ from typing import Dict, List, Optional, Tuple
 import torch
 
 import kage
-from kage import rundir
+from kage import plugins, rundir, tensorboard_log, video
+from kage.agent import Agent, RolloutPolicy, autocast, entropy_of
 from kage.stop import StopRequest
-from kage.agent import Agent, autocast, entropy_of, sample_gumbel_max
 from kage.counter_random import CounterRandom
 from kage.evaluation import METRICS, EpisodeMetrics, evaluation_rows
 from kage.wrappers import FrameStack, RewardNormalizer
 
 ACTION_STREAM, SHUFFLE_STREAM = 1, 2  # the two random streams of a run (§2.4); evaluations use their own keys
+AUGMENT_STREAM = 3  # --augment's draws (not in the original)
 
 
 @dataclass
@@ -62,6 +67,11 @@ class Args:
     exp_name: str = field(default="ppo_kage", metadata={"help": "name of the experiment"})
     threads: Optional[int] = field(default=None, metadata={"help": "CPU threads (default: all cores)"})
     asset_root: Optional[str] = field(default=None, metadata={"help": "resolve the configs' asset paths here"})
+    # Your own agent (kage.plugins)
+    agent: str = field(default=plugins.BASELINE_AGENT, metadata={
+        "help": "module:factory building the policy network (default: the baseline's Nature CNN)"})
+    augment: Optional[str] = field(default=None, metadata={
+        "help": "module:fn augmenting the update's minibatches, never evaluations (e.g. kage.augment:random_shift)"})
     # PPO (§2.1: the defaults of ppo_jax.py; the benchmark overrides none)
     total_timesteps: int = field(default=25_000_000, metadata={"help": "environment steps of the run"})
     learning_rate: float = field(default=5e-4, metadata={"help": "Adam learning rate"})
@@ -88,6 +98,9 @@ class Args:
     eval_episodes: int = field(default=128, metadata={"help": "episodes per config per evaluation"})
     eval_num_envs: int = field(default=32, metadata={"help": "parallel environments of an evaluation"})
     save_checkpoint_every: int = field(default=50, metadata={"help": "iterations between checkpoints (0: end only)"})
+    video_every: int = field(default=0, metadata={
+        "help": "record an episode per config (videos/<label>_iter_<i>.gif) at the evaluation points whose "
+                "iteration is a multiple of this (0: never)"})
     # Corrections of the original's quirks (off: as the original)
     bootstrap_truncation: bool = field(default=False, metadata={
         "help": "bootstrap from the final observation at truncation (QUIRK off: truncation is termination)"})
@@ -168,6 +181,10 @@ def validate(args: Args) -> List[str]:
         problems.append("at most 10 eval configs (the 11th would reuse the train config's evaluation seeds, §3.5)")
     if args.device == "cpu" and (args.bf16 or args.cuda_graph):
         problems.append("--bf16 and --cuda-graph are for --device cuda")
+    if args.video_every < 0:
+        problems.append("--video-every must not be negative")
+    if args.agent != plugins.BASELINE_AGENT and (args.fused_input or args.channels_last):
+        problems.append("--fused-input and --channels-last rewrite the baseline's network: drop them with --agent")
     return problems
 
 
@@ -320,12 +337,18 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
     K, T, N = len(runs), args.num_steps, args.num_envs
     height, width, channels = runs[0].env.single_observation_space.shape
     channels *= 4 if args.use_frame_stack else 1
-    agent = Agent([a.seed for a in pack], channels, height, width, device)  # §2.4: the runs' seeds
-    if args.channels_last:
-        agent = agent.to(memory_format=torch.channels_last)
-    if args.bf16:
-        agent.input_dtype = torch.bfloat16
-    agent.space_to_depth = args.fused_input
+    num_actions = runs[0].env.single_action_space.n
+    agent = plugins.build_agent(args.agent, (height, width, channels), num_actions, [a.seed for a in pack],
+                                device)  # §2.4: the runs' seeds
+    if isinstance(agent, Agent):  # the baseline's speed options
+        if args.channels_last:
+            agent = agent.to(memory_format=torch.channels_last)
+        if args.bf16:
+            agent.input_dtype = torch.bfloat16
+        agent.space_to_depth = args.fused_input
+    augment = plugins.load_augment(args.augment)
+    agent_spec = {"agent": args.agent, "observation_shape": [height, width, channels], "num_actions": num_actions,
+                  "use_frame_stack": args.use_frame_stack}  # what kage.evaluate needs to rebuild a run's policy
     optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5)
     random = CounterRandom([a.seed for a in pack], device)
     counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
@@ -351,6 +374,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
     last_length = torch.zeros((K, N), device=device)
     any_finished = torch.zeros(K, dtype=torch.bool, device=device)
     start_iteration, global_step, optimizer_steps, train_seconds = 1, 0, 0, 0.0
+    boards = [tensorboard_log.open_writer(run.dir.path, run.args) for run in runs]
 
     def observe() -> torch.Tensor:
         """The runs' current observations, [K, N, H, W, C]."""
@@ -375,6 +399,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
                 for name, value in c["normalizer"].items():
                     getattr(normalizer, name)[k] = value.to(device)
             run.history = c["history"]
+            boards[k].purge(c["global_step"])
         rundir.load_optimizer(optimizer, agent, [c["optimizer"] for c in checkpoints])
         c = checkpoints[0]
         start_iteration, global_step = c["iteration"] + 1, c["global_step"]
@@ -383,8 +408,10 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
             print(f"kage.train: resuming {run.dir.path} after iteration {c['iteration']}", file=sys.stderr)
     elif runs[0].eval_envs:
         with timer("eval"):  # §3.1: the untrained policy
-            for run, row in zip(runs, evaluation_rows(agent, runs, args, 0, 0)):
+            for run, board, row in zip(runs, boards, evaluation_rows(agent, runs, args, 0, 0)):
                 run.history.append(run.dir.log(row))
+                board.write(row)
+            video.record_runs(agent, runs, args, 0)
 
     def save_checkpoints(iteration: int) -> None:
         for k, run in enumerate(runs):
@@ -397,12 +424,12 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
                 "last_length": last_length[k].cpu(), "any_finished": any_finished[k].cpu(),
                 "frame_stack": stack.stack[k].cpu() if stack else None,
                 "normalizer": {n: v[k].cpu() for n, v in normalizer.state_dict().items()} if normalizer else None,
-                "history": run.history})
+                "history": run.history, "agent_spec": dict(agent_spec, seed=run.args.seed)})
 
     progress = rundir.Progress(args.num_iterations, args.batch_size * K)
     last_iteration = args.num_iterations if stop_after is None else min(args.num_iterations,
                                                                         start_iteration + stop_after - 1)
-    rollout = RolloutPolicy(agent, args, observe().shape, device)
+    rollout = RolloutPolicy(agent, args, observe().shape, num_actions, device)
     # Episodes end only by truncation at episode_length (§2.3): when no episode is shorter than a rollout, an
     # environment ends at most one per rollout, and its final info still holds it when the rollout is over,
     # so the episode metrics are read once per rollout instead of after every step.
@@ -424,7 +451,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
         episode_sums = torch.zeros((K, len(METRICS) + 1), device=device)  # count, then the nine metrics
         # The action stream's draws for the whole rollout; the counter names the iteration, so a run draws the
         # same numbers alone, packed or resumed.
-        noise = random.uniform(ACTION_STREAM, counter.fill_(iteration - 1), (T, N, 8))
+        noise = random.uniform(ACTION_STREAM, counter.fill_(iteration - 1), (T, N, num_actions))
 
         for step in range(T):  # §2.5 step 1
             with timer("forward"):
@@ -478,8 +505,12 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
             for start in range(0, args.batch_size, args.minibatch_size):
                 mb = permutation[:, start:start + args.minibatch_size]
                 with timer("update_forward"):
+                    mb_obs = b_obs[runs_axis, mb]
+                    if augment:  # the update's minibatch only: the rollout and evaluations see plain frames
+                        draws = plugins.augment_draws(random, AUGMENT_STREAM, counter, optimizer_steps)
+                        mb_obs = augment(mb_obs, draws)
                     with autocast(args.bf16):
-                        logits, new_value = agent(b_obs[runs_axis, mb])
+                        logits, new_value = agent(mb_obs)
                     logits, new_value = logits.float(), new_value.float()
                     new_logprob = torch.log_softmax(logits, -1).gather(-1, b_actions[runs_axis, mb, None]).squeeze(-1)
                     loss, pg_loss, v_loss, entropy, approx_kl, clipfrac = ppo_loss(
@@ -511,10 +542,13 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
             with timer("eval"):
                 eval_rows = evaluation_rows(agent, runs, args, iteration, global_step)
         for k, run in enumerate(runs):
-            run.dir.log(train_row(scalars[k], iteration, global_step, train_seconds, iteration_seconds, args,
-                                  optimizer.param_groups[0]["lr"], ent_coef))
+            row = run.dir.log(train_row(scalars[k], iteration, global_step, train_seconds, iteration_seconds, args,
+                                        optimizer.param_groups[0]["lr"], ent_coef))
             if eval_rows:
                 run.history.append(run.dir.log(eval_rows[k]))
+            boards[k].write(row, *eval_rows[k:k + 1])
+        if eval_rows:
+            video.record_runs(agent, runs, args, iteration)
         if (args.save_checkpoint_every > 0 and iteration % args.save_checkpoint_every == 0) or \
                 iteration == args.num_iterations or stop.requested:  # §2.5 step 7, at the end, and when asked
             save_checkpoints(iteration)
@@ -529,49 +563,11 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
         for run in runs:
             run.dir.finish(run.history)
             print(f"kage.train: done, {run.dir.path}/summary.json", file=sys.stderr)
-    for run in runs:
+    for run, board in zip(runs, boards):
         for env in [run.env, *run.eval_envs.values()]:
             env.close()
+        board.close()
     return runs
-
-
-class RolloutPolicy:
-    """The rollout's policy step: forward, Gumbel-max sampling (§1.4) with the given uniforms, the
-    log-probability and the value. Under --cuda-graph it is captured once and replayed each step from
-    static input buffers."""
-
-    def __init__(self, policy, args: Args, obs_shape, device):
-        self.policy, self.args = policy, args
-        self.graph = None
-        if args.cuda_graph:
-            self.obs = torch.zeros(obs_shape, dtype=torch.uint8, device=device)
-            self.uniform = torch.full((*obs_shape[:2], 8), 0.5, device=device)
-            side = torch.cuda.Stream()
-            side.wait_stream(torch.cuda.current_stream())
-            with torch.cuda.stream(side), torch.no_grad():
-                for _ in range(3):  # warm-up: cuDNN picks its algorithms outside the capture
-                    self._step()
-            torch.cuda.current_stream().wait_stream(side)
-            self.graph = torch.cuda.CUDAGraph()
-            with torch.cuda.graph(self.graph), torch.no_grad():
-                self.outputs = self._step()
-
-    def _step(self):
-        with autocast(self.args.bf16):
-            logits, value = self.policy(self.obs)
-        action, logprob = sample_gumbel_max(logits.float(), self.uniform)
-        return action, logprob, value.float()
-
-    @torch.no_grad()
-    def __call__(self, obs: torch.Tensor, uniform: torch.Tensor):
-        """obs [K, N, H, W, C] uint8, uniform [K, N, 8] in (0, 1) -> action, log-probability, value [K, N]."""
-        if self.graph is None:
-            self.obs, self.uniform = obs, uniform
-            return self._step()
-        self.obs.copy_(obs)
-        self.uniform.copy_(uniform)
-        self.graph.replay()
-        return self.outputs
 
 
 def train_row(s: List[float], iteration: int, global_step: int, train_seconds: float, iteration_seconds: float,

@@ -4,7 +4,8 @@ import pytest
 import torch
 
 from kage.agent import Agent, autocast
-from kage.train import Args, RolloutPolicy
+from kage.agent import RolloutPolicy
+from kage.train import Args
 
 
 @pytest.mark.parametrize("bf16", [False, True])

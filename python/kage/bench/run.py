@@ -2,7 +2,8 @@
 
 Trains every (pair, seed) of a suite manifest with `python3 -m kage.train`, each run in its own run
 directory, one process after the other; --pack K trains K runs at once in one process (one GPU), which
-the learner's batched forward and backward make several times faster in aggregate:
+the learner's batched forward and backward make several times faster in aggregate (an --agent that
+cannot be packed trains its runs one at a time):
 
     DIR/suite.json                  the suite's report (kagec suite): pairs, axes, paths, spec hashes, certificates
     DIR/bench.json                  the manifest, the seeds asked for so far and the trainer flags
@@ -27,7 +28,7 @@ import sys
 import time
 from typing import Dict, List, Optional
 
-from kage import _kage
+from kage import _kage, plugins
 from kage.errors import ConfigError
 from kage.files import atomic_write, write_json
 from kage.stop import ForwardSignals
@@ -251,6 +252,10 @@ def main(argv: List[str]) -> int:
             raise SystemExit(f"kage.bench run: {flag} is set per run by kage.bench; remove it")
     from kage import train
     probe = train.parse_args(["--train-config-path", args.suite, *trainer_args])  # trainer flags checked now
+    if args.pack > 1 and not plugins.is_packable(plugins.load(probe.agent, "--agent")):
+        print(f"kage.bench run: --agent {probe.agent} cannot be packed (its factory does not set packable = True): "
+              f"its runs train one at a time instead of {args.pack} at once", file=sys.stderr)
+        args.pack = 1
     seeds = parse_seeds(args.seeds)
     try:
         report = json.loads(_kage.suite_report(args.suite))

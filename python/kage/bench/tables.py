@@ -167,27 +167,28 @@ def status_text(status: dict) -> str:
     return text + "."
 
 
-def md_document(title: str, status: dict, body: str) -> str:
-    return f"# {title}\n\n{PROTOCOL_TEXT}\n\n{status_text(status)}\n\n{body}"
+def md_document(title: str, status: dict, body: str, protocol: str = PROTOCOL_TEXT) -> str:
+    return f"# {title}\n\n{protocol}\n\n{status_text(status)}\n\n{body}"
 
 
 # ---- writing ----
 
-def write_tables(out_dir: str, suite_name: str, levels: dict, status: dict) -> List[str]:
-    """The CSV and Markdown files; returns their names."""
+def write_tables(out_dir: str, suite_name: str, levels: dict, status: dict, protocol: str = PROTOCOL_TEXT) -> List[str]:
+    """The CSV and Markdown files; returns their names. `protocol` is the paragraph that says what a value is
+    (kage.evaluate's differs: one checkpoint instead of maxima over training)."""
     files = {"runs.csv": runs_csv(levels["runs"])}
     combined = []
     if levels["pairs"]:
         files["axes.csv"] = axes_csv(levels["axes"])
         files["pairs.csv"] = pairs_csv(levels["pairs"])
-        files["axes.md"] = md_document(f"{suite_name}: per axis", status, md_axes(levels["axes"], 2))
-        files["pairs.md"] = md_document(f"{suite_name}: per pair", status, md_pairs(levels["pairs"], 2))
+        files["axes.md"] = md_document(f"{suite_name}: per axis", status, md_axes(levels["axes"], 2), protocol)
+        files["pairs.md"] = md_document(f"{suite_name}: per pair", status, md_pairs(levels["pairs"], 2), protocol)
         combined += [f"## Per axis\n\n{md_axes(levels['axes'], 3)}", f"## Per pair\n\n{md_pairs(levels['pairs'], 3)}"]
     if levels["sweeps"]:
         files["sweeps.csv"] = sweeps_csv(levels["sweeps"])
-        files["sweeps.md"] = md_document(f"{suite_name}: sweeps", status, md_sweeps(levels["sweeps"], 2))
+        files["sweeps.md"] = md_document(f"{suite_name}: sweeps", status, md_sweeps(levels["sweeps"], 2), protocol)
         combined.append(f"## Sweeps\n\n{md_sweeps(levels['sweeps'], 3)}")
-    files["report.md"] = md_document(f"{suite_name}: benchmark report", status, "\n".join(combined))
+    files["report.md"] = md_document(f"{suite_name}: benchmark report", status, "\n".join(combined), protocol)
     for name, text in files.items():
         atomic_write(os.path.join(out_dir, name), text.encode())
     return sorted(files)
