@@ -61,6 +61,8 @@ def script(bench: run.Bench, table: List[List[tasks.Job]], args: argparse.Namesp
              "# (written by python3 -m kage.bench slurm; progress: python3 -m kage.bench status DIR)",
              *(f"#SBATCH {d}" for d in directives),
              "set -euo pipefail",
+             "# Specs name asset directories relative to the working directory: every task resolves from this one",
+             f"cd {shlex.quote(os.getcwd())}",
              f"export PYTHONPATH={shlex.quote(package_root())}${{PYTHONPATH:+:$PYTHONPATH}}",
              f"exec {command} --task \"$SLURM_ARRAY_TASK_ID\"",
              "",
