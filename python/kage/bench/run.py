@@ -1,13 +1,20 @@
-"""python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [trainer flags]
+"""python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [--pack K] [--task I | --gpus all|0,2]
+[trainer flags]
 
 Trains every (pair, seed) of a suite manifest with `python3 -m kage.train`, each run in its own run
 directory, one process after the other; --pack K trains K runs at once in one process (one GPU), which
-the learner's batched forward and backward make several times faster in aggregate:
+the learner's batched forward and backward make several times faster in aggregate. The runs form a fixed
+task table (kage.bench.tasks): --task I trains task I alone (a Slurm array task, kage.bench slurm), and
+--gpus keeps one worker per GPU busy with the tasks (kage.bench.gpus).
 
     DIR/suite.json                  the suite's report (kagec suite): pairs, axes, paths, spec hashes, certificates
     DIR/bench.json                  the manifest, the seeds asked for so far and the trainer flags
-    DIR/runs/<pair>/seed_<s>/       a training run (kage.train's run directory) and its train.log
+    DIR/tasks.json                  the task table: the runs of each task
+    DIR/runs/<pair>/seed_<s>/       a training run (kage.train's run directory), its train.log and
+                                    bench_state.json (running, failed or stopped: kage.bench.run_state)
     DIR/packs/pack_<i>.json, .log   under --pack: the runs one process trained together, and its log
+                                    (task_<I>_pack_<i> under --task I)
+    DIR/tasks/task_<I>.log          under --gpus: the log of task I's process
 
 A plain pair trains on its train config and evaluates on its eval config (label "eval"). A sweep (one
 train config, several evals) runs once per seed and evaluates every eval config of the sweep (labels:
