@@ -10,7 +10,7 @@ import socket
 import subprocess
 import tempfile
 import time
-from typing import Dict, List
+from typing import Dict, List, Optional
 
 
 class ClusterError(RuntimeError):
@@ -132,7 +132,7 @@ class LocalSlurm:
             return result.returncode == 0 and result.stdout.strip() == "idle"
         self.wait_for(idle, f"sinfo to show node {self.node} idle")
 
-    def wait_for(self, ready, what: str, timeout: float = None) -> None:
+    def wait_for(self, ready, what: str, timeout: Optional[float] = None) -> None:
         deadline = time.monotonic() + (timeout or self.start_timeout)
         while not ready():
             for name, daemon in self.daemons.items():

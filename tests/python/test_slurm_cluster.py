@@ -3,7 +3,6 @@ a 2-task job array of tiny CPU runs submitted with `kage.bench slurm --submit`, 
 report; then a task cancelled with scancel while it trains, resubmitted, and resumed from its checkpoint
 rather than restarted. Every wait is bounded; a failure shows the daemons' logs and the tasks' logs."""
 import json
-import os
 import subprocess
 import sys
 import time
@@ -28,9 +27,8 @@ def with_flags(flags, **changes):
 
 
 def bench(slurm, *args):
-    result = subprocess.run([sys.executable, "-m", "kage.bench", *args], cwd=ROOT, capture_output=True, text=True,
-                            timeout=300, env=slurm.env)
-    return result
+    return subprocess.run([sys.executable, "-m", "kage.bench", *args], cwd=ROOT, capture_output=True, text=True,
+                          timeout=300, env=slurm.env)
 
 
 def submit(slurm, out, pairs, training) -> str:
