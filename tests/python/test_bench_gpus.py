@@ -1,11 +1,14 @@
 """kage.bench run --gpus on the CPU, with fake devices (KAGE_BENCH_FAKE_GPUS): one worker per device takes
 tasks until none is left, each task's process sees its own device, a rerun trains nothing, and one report
-covers every task's runs; the device list is checked."""
+covers every task's runs; the device list is checked and follows an outer CUDA_VISIBLE_DEVICES."""
 import json
 import os
 import subprocess
 import sys
 
+import pytest
+
+from kage.bench import gpus, run
 from support import ROOT, TINY_TRAINING
 
 PAIRS = ["background/1", "agent_appearance/1", "distractors/1"]
@@ -45,13 +48,28 @@ def test_two_fake_gpus_train_three_tasks(tmp_path):
     assert "3 runs: 3 done, 0 running, 0 failed, 0 interrupted, 0 not started" in status.stdout
 
 
-def test_the_device_list_is_checked(tmp_path):
-    args = ["run", "suites/kage_bench.yaml", "--pairs", "background/1", "--seeds", "1", "--out", str(tmp_path)]
-    for gpus, fake, message in (("0,2", "2", "this machine's GPUs are 0 to 1"),
-                                ("0,0", "2", "each named once"),
-                                ("first", "2", "use 'all' or GPU indices like 0,2"),
-                                ("all", "0", "torch sees no CUDA GPU")):
-        result = bench(*args, *TINY_TRAINING, "--gpus", gpus, fake_gpus=fake)
-        assert result.returncode != 0 and message in result.stderr, (gpus, result.stderr)
-    both = bench(*args, *TINY_TRAINING, "--gpus", "all", "--task", "0")
-    assert both.returncode != 0 and "--task and --gpus exclude each other" in both.stderr
+def test_the_device_list_is_checked(monkeypatch):
+    monkeypatch.delenv("CUDA_VISIBLE_DEVICES", raising=False)
+    monkeypatch.setenv(gpus.FAKE_GPUS, "3")
+    assert gpus.parse_gpus("all", "cpu") == ["0", "1", "2"]
+    assert gpus.parse_gpus("2,0", "cpu") == ["2", "0"]
+    for text, message in (("0,3", "this machine's GPUs are 0 to 2"), ("0,0", "each named once"),
+                          ("first", "use 'all' or GPU indices like 0,2")):
+        with pytest.raises(SystemExit, match=message):
+            gpus.parse_gpus(text, "cpu")
+    monkeypatch.setenv(gpus.FAKE_GPUS, "0")
+    with pytest.raises(SystemExit, match="torch sees no CUDA GPU"):
+        gpus.parse_gpus("all", "cpu")
+    with pytest.raises(SystemExit, match="--task and --gpus exclude each other"):
+        run.main(["suites/kage_bench.yaml", "--out", "unused", "--gpus", "all", "--task", "0"])
+
+
+def test_an_outer_allocation_maps_the_indices(monkeypatch):
+    """Under Slurm's (or anyone's) CUDA_VISIBLE_DEVICES, index i is the i-th GPU this process sees."""
+    monkeypatch.delenv(gpus.FAKE_GPUS, raising=False)
+    monkeypatch.setenv("CUDA_VISIBLE_DEVICES", "3,5")
+    monkeypatch.setattr(gpus, "device_count", lambda: 2)
+    assert gpus.parse_gpus("all", "cuda") == ["3", "5"]
+    assert gpus.parse_gpus("1", "cuda") == ["5"]
+    with pytest.raises(SystemExit, match="remove --device cpu, or --gpus"):
+        gpus.parse_gpus("all", "cpu")
