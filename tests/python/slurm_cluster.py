@@ -137,7 +137,8 @@ class LocalSlurm:
         while not ready():
             for name, daemon in self.daemons.items():
                 if daemon.poll() is not None:
-                    raise ClusterError(f"{name} exited with {daemon.returncode} while waiting for {what}\n{self.logs()}")
+                    raise ClusterError(f"{name} exited with {daemon.returncode} while waiting for {what}\n"
+                                       f"{self.logs()}")
             if time.monotonic() > deadline:
                 raise ClusterError(f"timed out waiting for {what}\n{self.logs()}")
             time.sleep(0.5)

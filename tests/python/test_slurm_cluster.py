@@ -84,7 +84,8 @@ def test_job_array_on_a_local_slurm(tmp_path):
                 return json.loads((run_dir / "checkpoints" / "latest.json").read_text())["iteration"]
             except (OSError, ValueError):
                 return 0
-        wait_until(lambda: checkpointed() >= 2, "the run's second checkpoint", 600, lambda: task_logs(out) + slurm.logs())
+        wait_until(lambda: checkpointed() >= 2, "the run's second checkpoint", 600,
+                   lambda: task_logs(out) + slurm.logs())
         status = bench(slurm, "status", str(out))
         assert "1 runs: 0 done, 1 running" in status.stdout, status.stdout
         slurm.command("scancel", job)

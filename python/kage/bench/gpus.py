@@ -84,7 +84,8 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
                     failed.append(index)
                 left = len(todo) + sum(c.poll() is None for c in children.values())
                 eta = (time.monotonic() - started) / done[0] * left
-                status = "done" if code == 0 else f"FAILED (exit {code}); see {log.name}"
+                status = ("done" if code == 0 else "stopped" if stopping.is_set()
+                          else f"FAILED (exit {code}); see {log.name}")
                 print(f"[gpu {device}] task {index}: {status} · tasks left {left} · ETA {eta / 60:,.0f} min",
                       file=sys.stderr, flush=True)
 
