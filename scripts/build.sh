@@ -8,7 +8,7 @@ packages=(build-essential cmake ninja-build pkg-config
           libyaml-cpp-dev nlohmann-json3-dev libfmt-dev libstb-dev catch2 libcli11-dev
           python3-jsonschema python3-yaml clang libclang-rt-14-dev
           python3-dev pybind11-dev libdlpack-dev python3-numpy python3-pytest python3-torch python3-matplotlib
-          python3-pil)
+          python3-pil slurm-wlm munge)  # pil: GIF videos; slurm-wlm, munge: the kage.bench job-array test starts a one-node Slurm cluster
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

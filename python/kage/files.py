@@ -2,11 +2,13 @@
 content, never a part."""
 import json
 import os
+import socket
 
 
 def atomic_write(path: str, data: bytes) -> None:
-    """Writes `data` beside `path`, syncs it, then renames it over `path`."""
-    tmp = f"{path}.tmp.{os.getpid()}"
+    """Writes `data` beside `path`, syncs it, then renames it over `path`. The temporary name is the
+    writer's own (host and process), for processes of several hosts sharing a directory (a Slurm array)."""
+    tmp = f"{path}.tmp.{socket.gethostname()}.{os.getpid()}"
     with open(tmp, "wb") as f:
         f.write(data)
         f.flush()

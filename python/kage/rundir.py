@@ -62,6 +62,7 @@ class RunDir:
         self.path = path
         self.specs = specs
         self._log = None
+        self._warned_not_finite = False
 
     @property
     def finished(self) -> bool:
@@ -104,9 +105,19 @@ class RunDir:
     # ---- the log ----
 
     def log(self, row: dict) -> dict:
-        """Appends one row to metrics.jsonl, flushed and synced; returns it."""
+        """Appends one row to metrics.jsonl, flushed and synced; returns it. A value that is not finite (a
+        diverged run's losses) is written as null, with a warning the first time: the run's log stays
+        valid JSON, and the other runs of its pack go on."""
         if self._log is None:
             self._log = open(os.path.join(self.path, "metrics.jsonl"), "a")
+        bad = sorted(k for k, v in row.items() if isinstance(v, float) and not math.isfinite(v))
+        if bad:
+            row = {k: None if k in bad else v for k, v in row.items()}
+            if not self._warned_not_finite:
+                print(f"kage.train: warning: {self.path}: {', '.join(bad)} not finite at iteration "
+                      f"{row.get('iteration')}: the run has diverged; such values are logged as null",
+                      file=sys.stderr, flush=True)
+                self._warned_not_finite = True
         self._log.write(json.dumps(row, sort_keys=True, allow_nan=False) + "\n")
         self._log.flush()
         os.fsync(self._log.fileno())

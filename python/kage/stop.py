@@ -1,6 +1,7 @@
 """Stopping on request: SIGTERM (a scheduler's preemption, `timeout`, `kill`) or SIGINT (Ctrl-C) lets the
 running iteration finish, then the trainer checkpoints and exits, so a rerun resumes with nothing lost.
-A second signal stops at once (the run then resumes from its previous checkpoint)."""
+A second Ctrl-C stops at once (the run then resumes from its previous checkpoint); a repeated SIGTERM
+changes nothing, since schedulers and kage.bench may both send one."""
 import signal
 import sys
 from typing import Optional
@@ -27,9 +28,11 @@ class StopRequest:
 
     def _note(self, signum: int, frame) -> None:
         if self.signum is not None:
-            raise KeyboardInterrupt
+            if signum == signal.SIGINT:
+                raise KeyboardInterrupt
+            return
         self.signum = signum
-        print(f"{self.who}: {signal.Signals(signum).name}: {self.then} (send it again to stop at once)",
+        print(f"{self.who}: {signal.Signals(signum).name}: {self.then} (Ctrl-C again to stop at once)",
               file=sys.stderr, flush=True)
 
     @property
@@ -40,27 +43,3 @@ class StopRequest:
     def exit_code(self) -> int:
         return 128 + (self.signum or 0)  # the shell's convention for "ended by signal N"
 
-
-class ForwardSignals:
-    """While a training process runs in its own session (so that a terminal's Ctrl-C or a kill of the
-    process group reaches it once, through here), passes each SIGTERM/SIGINT on to it and remembers the
-    first, so the caller starts nothing more."""
-
-    def __init__(self):
-        self.child = None
-        self.signum: Optional[int] = None
-        self._previous = {}
-
-    def __enter__(self) -> "ForwardSignals":
-        for s in SIGNALS:
-            self._previous[s] = signal.signal(s, self._forward)
-        return self
-
-    def __exit__(self, *exc) -> None:
-        for s, handler in self._previous.items():
-            signal.signal(s, handler)
-
-    def _forward(self, signum: int, frame) -> None:
-        self.signum = self.signum or signum
-        if self.child is not None and self.child.poll() is None:
-            self.child.send_signal(signum)

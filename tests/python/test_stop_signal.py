@@ -1,6 +1,6 @@
 """SIGTERM (a scheduler's preemption, `timeout`) stops a run without losing work: kage.bench run passes it
 to its training process, which finishes the iteration, checkpoints it (even with periodic checkpoints off)
-and exits 143; the same command then resumes, and the run ends exactly as an uninterrupted one."""
+and exits; kage.bench run exits 143 and the same command then resumes, and the run ends exactly as an uninterrupted one."""
 import json
 import signal
 import subprocess
@@ -46,7 +46,7 @@ def test_sigterm_checkpoints_and_resumes(tmp_path):
     child.send_signal(signal.SIGTERM)
     output = child.communicate(timeout=300)[0]
     assert child.returncode == 128 + signal.SIGTERM, output
-    assert "stopped by SIGTERM" in output and "run the same command again to resume" in output
+    assert "kage.bench run: stopped background/1 seed 1; run again (or requeue) to resume" in output
     log = (run_dir / "train.log").read_text()
     assert "kage.train: stopped after iteration" in log
     checkpointed = json.loads((run_dir / "checkpoints" / "latest.json").read_text())["iteration"]

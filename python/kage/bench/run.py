@@ -1,14 +1,21 @@
-"""python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [trainer flags]
+"""python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [--pack K] [--task I | --gpus all|0,2]
+[trainer flags]
 
 Trains every (pair, seed) of a suite manifest with `python3 -m kage.train`, each run in its own run
 directory, one process after the other; --pack K trains K runs at once in one process (one GPU), which
-the learner's batched forward and backward make several times faster in aggregate (an --agent that
-cannot be packed trains its runs one at a time):
+the learner's batched forward and backward make several times faster in aggregate. The runs form a fixed
+task table (kage.bench.tasks): --task I trains task I alone (a Slurm array task, kage.bench slurm), and
+--gpus keeps one worker per GPU busy with the tasks (kage.bench.gpus). An --agent that cannot be
+packed trains its runs one at a time.
 
     DIR/suite.json                  the suite's report (kagec suite): pairs, axes, paths, spec hashes, certificates
     DIR/bench.json                  the manifest, the seeds asked for so far and the trainer flags
-    DIR/runs/<pair>/seed_<s>/       a training run (kage.train's run directory) and its train.log
+    DIR/tasks.json                  the task table: the runs of each task
+    DIR/runs/<pair>/seed_<s>/       a training run (kage.train's run directory), its train.log and
+                                    bench_state.json (running, failed or stopped: kage.bench.run_state)
     DIR/packs/pack_<i>.json, .log   under --pack: the runs one process trained together, and its log
+                                    (task_<I>_pack_<i> under --task I)
+    DIR/tasks/task_<I>.log          under --gpus: the log of task I's process
 
 A plain pair trains on its train config and evaluates on its eval config (label "eval"). A sweep (one
 train config, several evals) runs once per seed and evaluates every eval config of the sweep (labels:
@@ -29,9 +36,9 @@ import time
 from typing import Dict, List, Optional
 
 from kage import _kage, plugins
+from kage.bench import gpus, run_state, tasks
 from kage.errors import ConfigError
 from kage.files import atomic_write, write_json
-from kage.stop import ForwardSignals
 
 
 @dataclasses.dataclass
@@ -51,10 +58,10 @@ def parse_seeds(text: str) -> List[int]:
     for part in text.split(","):
         m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
         if not m:
-            raise SystemExit(f"kage.bench run: --seeds {text!r}: use a range like 1-10, a list like 1,3,5, or one seed")
+            raise SystemExit(f"kage.bench: --seeds {text!r}: use a range like 1-10, a list like 1,3,5, or one seed")
         first, last = int(m[1]), int(m[2] or m[1])
         if last < first:
-            raise SystemExit(f"kage.bench run: --seeds {text!r}: the range {first}-{last} is empty")
+            raise SystemExit(f"kage.bench: --seeds {text!r}: the range {first}-{last} is empty")
         seeds.extend(range(first, last + 1))
     return sorted(set(seeds))
 
@@ -64,7 +71,7 @@ def units_of(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
     units: Dict[str, Unit] = {}
     for p in report["pairs"]:
         if p["train"]["name"] == "(inline)" or p["eval"]["name"] == "(inline)":
-            raise SystemExit(f"kage.bench run: pair {p['pair']} writes a config inline in the manifest; "
+            raise SystemExit(f"kage.bench: pair {p['pair']} writes a config inline in the manifest; "
                              "kage.bench trains only configs in files: move it to a file")
         if p["sweep"] is None:
             units[p["pair"]] = Unit(p["pair"], p["declared_axis"], p["train"]["name"], [p["eval"]["name"]], ["eval"])
@@ -81,10 +88,10 @@ def units_of(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
             continue
         sweep = next((u.name for u in units.values() if name.startswith(u.name + "/") and len(u.evals) > 1), None)
         if sweep:
-            raise SystemExit(f"kage.bench run: {name} is one eval of the sweep '{sweep}'; select the sweep as a whole")
+            raise SystemExit(f"kage.bench: {name} is one eval of the sweep '{sweep}'; select the sweep as a whole")
         close = difflib.get_close_matches(name, units, n=3)
         hint = f"; did you mean {', '.join(close)}?" if close else f"; the suite has {', '.join(list(units)[:6])} ..."
-        raise SystemExit(f"kage.bench run: no pair or sweep named '{name}' in the suite{hint}")
+        raise SystemExit(f"kage.bench: no pair or sweep named '{name}' in the suite{hint}")
     return chosen
 
 
@@ -102,7 +109,7 @@ def check_suite_unchanged(out: str, report: dict) -> None:
         for side in ("train", "eval"):
             if old[side]["spec_sha256"] != p[side]["spec_sha256"]:
                 raise SystemExit(
-                    f"kage.bench run: config '{p[side]['name']}' ({p['pair']}, {side}) changed since {out} was "
+                    f"kage.bench: config '{p[side]['name']}' ({p['pair']}, {side}) changed since {out} was "
                     f"started (spec {old[side]['spec_sha256'][:12]} then, {p[side]['spec_sha256'][:12]} now): "
                     "restore it, or run into another --out")
 
@@ -115,7 +122,7 @@ def record_bench(out: str, manifest: str, seeds: List[int], units: List[str], tr
         with open(path) as f:
             previous = json.load(f)
         if previous["trainer_args"] != trainer_args:
-            raise SystemExit(f"kage.bench run: {out} was started with trainer flags {previous['trainer_args']}, now "
+            raise SystemExit(f"kage.bench: {out} was started with trainer flags {previous['trainer_args']}, now "
                              f"{trainer_args}: use the same flags (results must share one protocol), or another --out")
         seeds = sorted(set(previous["seeds"]) | set(seeds))
         units = previous["units"] + [u for u in units if u not in previous["units"]]
@@ -146,11 +153,10 @@ def packs_of(jobs: List[tuple], size: int) -> List[List[tuple]]:
     return [group[i:i + size] for group in groups.values() for i in range(0, len(group), size)]
 
 
-def write_pack_file(out: str, index: int, pack: List[tuple], trainer_args: List[str]) -> str:
-    """DIR/packs/pack_<index>.json: the pack's runs as kage.train arguments (python3 -m kage.train --pack)."""
+def write_pack_file(path: str, pack: List[tuple], trainer_args: List[str]) -> str:
+    """The pack's runs as kage.train arguments (python3 -m kage.train --pack)."""
     from kage import train
     runs = [dataclasses.asdict(train.parse_args(train_flags(u, s, d, trainer_args))) for u, s, d in pack]
-    path = os.path.join(out, "packs", f"pack_{index}.json")
     os.makedirs(os.path.dirname(path), exist_ok=True)
     atomic_write(path, json.dumps({"runs": runs}, indent=1).encode())  # infinities as Infinity: read by Python
     return path
@@ -201,55 +207,58 @@ def last_progress(metrics_path: str):
     return 0, None
 
 
-def train_packs(out: str, pack_size: int, trainer_args: List[str], pending: List[tuple], display: Display,
-                signals: ForwardSignals) -> List[str]:
-    """Trains the pending runs pack after pack, each pack in a `python3 -m kage.train` process; returns the
-    labels of the failed runs. A signal is passed on to the running process and ends the loop."""
-    failures = []
-    for index, pack in enumerate(packs_of(pending, pack_size)):
-        if signals.signum:
-            break
-        labels = [f"{u.name} seed {s}" for u, s, _ in pack]
-        if len(pack) == 1:
-            log_path = os.path.join(pack[0][2], "train.log")
-            command = train_flags(*pack[0], trainer_args)
-        else:
-            log_path = os.path.join(out, "packs", f"pack_{index}.log")
-            command = ["--pack", write_pack_file(out, index, pack, trainer_args)]
-        label = labels[0] if len(pack) == 1 else f"pack of {len(pack)} ({labels[0]}, ...)"
-        with open(log_path, "ab") as log:
-            signals.child = subprocess.Popen([sys.executable, "-m", "kage.train", *command], stdout=log, stderr=log,
-                                             start_new_session=True)
-            while signals.child.poll() is None:
-                display.running(label, os.path.join(pack[0][2], "metrics.jsonl"), len(pack))
-                time.sleep(1.0)
-        returncode = signals.child.returncode
-        for one in labels:
-            if returncode == 0:
-                display.finished(one, "done")
-            elif signals.signum:
-                display.finished(one, "stopped (checkpointed)")
-            else:
-                failures.append(one)
-                display.finished(one, f"FAILED (exit {returncode}); see {log_path}")
-    return failures
+class Stop(Exception):
+    """SIGTERM (Slurm's scancel, preemption, a requeue) or Ctrl-C: stop the runs, keep their checkpoints."""
 
 
-def main(argv: List[str]) -> int:
-    parser = argparse.ArgumentParser(prog="python3 -m kage.bench run", description=__doc__.split("\n\n")[0],
-                                     epilog="Any other flag is a trainer flag (python3 -m kage.train --help).")
+def raise_stop(signum, frame):
+    raise Stop()
+
+
+@dataclasses.dataclass
+class Bench:
+    """A benchmark directory's runs, as `prepare` checked and recorded them."""
+
+    suite: str
+    out: str
+    seeds_text: str
+    pairs: Optional[List[str]]
+    pack: int
+    trainer_args: List[str]
+    units: List[Unit]
+    seeds: List[int]
+    steps_per_run: int
+    device: str
+
+    def table(self) -> List[List[tasks.Job]]:
+        return tasks.task_table(self.units, self.seeds, self.pack, self.out)
+
+    def run_command(self) -> List[str]:
+        """`python3 -m kage.bench run` with this benchmark's arguments (append --task I)."""
+        pairs = ["--pairs", *self.pairs] if self.pairs else []
+        return [sys.executable, "-m", "kage.bench", "run", self.suite, "--seeds", self.seeds_text, "--out", self.out,
+                "--pack", str(self.pack), *pairs, *self.trainer_args]
+
+
+def add_bench_arguments(parser: argparse.ArgumentParser) -> None:
+    """The arguments that choose a benchmark's runs (kage.bench run and slurm)."""
     parser.add_argument("suite", help="a suite manifest (suites/*.yaml)")
     parser.add_argument("--seeds", default="1-10", help="seeds: 1-10 (default), 1,3,5 or 7")
     parser.add_argument("--out", required=True, help="the benchmark directory (created, or continued)")
     parser.add_argument("--pairs", nargs="+", help="only these pairs or sweeps (by name)")
     parser.add_argument("--pack", type=int, default=1, help="train K runs at once in one process (default 1)")
-    args, trainer_args = parser.parse_known_args(argv)
+
+
+def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
+    """Checks the arguments, the trainer flags and the suite, then records the benchmark in args.out
+    (suite.json, bench.json, tasks.json). The suite and DIR are named by absolute paths from here on, so
+    that every process of the benchmark resolves the same configs wherever it starts."""
     if args.pack < 1:
-        raise SystemExit(f"kage.bench run: --pack {args.pack}: a positive number of runs per process")
+        raise SystemExit(f"kage.bench: --pack {args.pack}: a positive number of runs per process")
     for flag in ("--train-config-path", "--eval-config-path", "--eval-config-paths", "--eval-config-labels",
                  "--seed", "--out", "--exp-name"):
         if flag in trainer_args:
-            raise SystemExit(f"kage.bench run: {flag} is set per run by kage.bench; remove it")
+            raise SystemExit(f"kage.bench: {flag} is set per run by kage.bench; remove it")
     from kage import train
     probe = train.parse_args(["--train-config-path", args.suite, *trainer_args])  # trainer flags checked now
     if args.pack > 1 and not plugins.is_packable(plugins.load(probe.agent, "--agent")):
@@ -257,39 +266,121 @@ def main(argv: List[str]) -> int:
               f"its runs train one at a time instead of {args.pack} at once", file=sys.stderr)
         args.pack = 1
     seeds = parse_seeds(args.seeds)
+    suite, out = os.path.abspath(args.suite), os.path.abspath(args.out)
     try:
-        report = json.loads(_kage.suite_report(args.suite))
+        report = json.loads(_kage.suite_report(suite))
     except ConfigError as e:
-        raise SystemExit(f"{e}\nkage.bench run: fix the suite first") from None
+        raise SystemExit(f"{e}\nkage.bench: fix the suite first") from None
     units = units_of(report, args.pairs)
     for p in report["pairs"]:
         if not p["certified"] and any(p["pair"] == u.name or p["sweep"] == u.name for u in units):
-            print(f"kage.bench run: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
+            print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
 
-    os.makedirs(args.out, exist_ok=True)
-    check_suite_unchanged(args.out, report)
-    record_bench(args.out, args.suite, seeds, [u.name for u in units], trainer_args)
-    write_json(os.path.join(args.out, "suite.json"), report)
+    os.makedirs(out, exist_ok=True)
+    check_suite_unchanged(out, report)
+    record_bench(out, suite, seeds, [u.name for u in units], trainer_args)
+    write_json(os.path.join(out, "suite.json"), report)
+    bench = Bench(suite, out, args.seeds, args.pairs, args.pack, trainer_args, units, seeds,
+                  probe.num_iterations * probe.batch_size, probe.device)
+    tasks.write_task_table(out, bench.table(), args.pack)
+    return bench
 
-    jobs = [(u, s, os.path.join(args.out, "runs", u.name, f"seed_{s}")) for u in units for s in seeds]
-    display = Display(len(jobs), probe.num_iterations * probe.batch_size)
+
+def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Optional[int]) -> int:
+    """Trains `jobs` (unit, seed, run_dir) one pack of up to K after the other, skipping finished runs."""
+    display = Display(len(jobs), bench.steps_per_run)
     pending = []
-    for unit, seed, run_dir in jobs:
-        if os.path.exists(os.path.join(run_dir, "summary.json")):
-            display.finished(f"{unit.name} seed {seed}", "finished earlier, skipped")
+    for job in jobs:
+        if tasks.is_finished(job):
+            display.finished(f"{job[0].name} seed {job[1]}", "finished earlier, skipped")
         else:
-            os.makedirs(run_dir, exist_ok=True)
-            pending.append((unit, seed, run_dir))
-    with ForwardSignals() as signals:
-        failures = train_packs(args.out, args.pack, trainer_args, pending, display, signals)
-    if signals.signum:
-        print(f"kage.bench run: stopped by {signal.Signals(signals.signum).name}; the runs keep their checkpoints: "
-              "run the same command again to resume", file=sys.stderr)
-        return 128 + signals.signum
+            os.makedirs(job[2], exist_ok=True)
+            pending.append(job)
+    failures = []
+    for index, pack in enumerate(packs_of(pending, bench.pack)):
+        labels = [f"{u.name} seed {s}" for u, s, _ in pack]
+        run_dirs = [d for _, _, d in pack]
+        if len(pack) == 1:
+            log_path = os.path.join(pack[0][2], "train.log")
+            command = train_flags(*pack[0], bench.trainer_args)
+        else:
+            pack_path = os.path.join(bench.out, "packs", f"{pack_prefix}{index}.json")
+            log_path = pack_path[:-len(".json")] + ".log"
+            command = ["--pack", write_pack_file(pack_path, pack, bench.trainer_args)]
+        label = labels[0] if len(pack) == 1 else f"pack of {len(pack)} ({labels[0]}, ...)"
+        run_state.mark(run_dirs, "running", task=task, log=log_path)
+        with open(log_path, "ab") as log:
+            # Its own session: a terminal's Ctrl-C or a kill of our process group reaches it through stop_child.
+            child = subprocess.Popen([sys.executable, "-m", "kage.train", *command], stdout=log, stderr=log,
+                                     start_new_session=True)
+            try:
+                beat = time.monotonic()
+                while child.poll() is None:
+                    display.running(label, os.path.join(pack[0][2], "metrics.jsonl"), len(pack))
+                    if time.monotonic() - beat > run_state.HEARTBEAT_S:
+                        run_state.mark(run_dirs, "running", task=task, log=log_path)
+                        beat = time.monotonic()
+                    time.sleep(1.0)
+            except (Stop, KeyboardInterrupt):
+                stop_child(child)
+                run_state.mark(run_dirs, "stopped", task=task, log=log_path)
+                print(f"\nkage.bench run: stopped {', '.join(labels)}; run again (or requeue) to resume them from "
+                      "their last checkpoints", file=sys.stderr, flush=True)
+                return 128 + signal.SIGTERM
+        if child.returncode == 0:
+            run_state.mark(run_dirs, "done", task=task, log=log_path)
+        else:
+            run_state.mark(run_dirs, "failed", task=task, log=log_path, exit_code=child.returncode,
+                           error=run_state.last_error(log_path))
+        for one in labels:
+            if child.returncode == 0:
+                display.finished(one, "done")
+            else:
+                failures.append(one)
+                display.finished(one, f"FAILED (exit {child.returncode}); see {log_path}")
     if failures:
         print(f"kage.bench run: {len(failures)} run(s) failed: {', '.join(failures)}; rerun to resume them",
               file=sys.stderr)
         return 1
-    print(f"kage.bench run: {len(jobs)} runs in {args.out}; tables and plots: python3 -m kage.bench report {args.out}",
-          file=sys.stderr)
     return 0
+
+
+def stop_child(child: subprocess.Popen) -> None:
+    """SIGTERM, which makes the trainer checkpoint after its running iteration (an evaluation point
+    included), then SIGKILL after a grace period: the run resumes from its last checkpoint either way."""
+    if child.poll() is None:
+        child.terminate()
+    try:
+        child.wait(timeout=180)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        child.wait()
+
+
+def main(argv: List[str]) -> int:
+    parser = argparse.ArgumentParser(prog="python3 -m kage.bench run", description=__doc__.split("\n\n")[0],
+                                     epilog="Any other flag is a trainer flag (python3 -m kage.train --help).")
+    add_bench_arguments(parser)
+    parser.add_argument("--task", type=int, help="train only task I of DIR/tasks.json (a Slurm array task)")
+    parser.add_argument("--gpus", help="'all' or a list like 0,2: one worker process per GPU, each training "
+                                       "tasks until none is left")
+    args, trainer_args = parser.parse_known_args(argv)
+    if args.task is not None and args.gpus:
+        raise SystemExit("kage.bench run: --task and --gpus exclude each other: --gpus runs the tasks itself")
+    bench = prepare(args, trainer_args)
+    devices = gpus.parse_gpus(args.gpus, bench.device) if args.gpus else None
+    table = bench.table()
+    signal.signal(signal.SIGTERM, raise_stop)
+    if devices:
+        return gpus.run_on_gpus(bench, table, devices)
+    if args.task is None:
+        status = train_jobs(bench, [job for task in table for job in task], "pack_", None)
+    elif not 0 <= args.task < len(table):
+        raise SystemExit(f"kage.bench run: --task {args.task}: the task table of {bench.out} has {len(table)} "
+                         f"tasks, 0 to {len(table) - 1} (see tasks.json)")
+    else:
+        status = train_jobs(bench, table[args.task], f"task_{args.task}_pack_", args.task)
+    if status == 0 and args.task is None:
+        print(f"kage.bench run: {sum(map(len, table))} runs in {bench.out}; tables and plots: "
+              f"python3 -m kage.bench report {bench.out}", file=sys.stderr)
+    return status

@@ -1,0 +1,114 @@
+"""kage.bench run --gpus all|0,2,...: every GPU of one host busy until the benchmark is done. One worker per
+GPU takes the next unfinished task of the task table and trains it in a child process
+(`kage.bench run ... --task I`, its log in DIR/tasks/task_<I>.log) that sees that GPU alone, until no task
+is left: the same tasks as a Slurm array, resumable the same way, one report.
+
+KAGE_BENCH_FAKE_GPUS=N stands for N GPUs that do not exist, for testing the scheduler on a machine without
+one (with --device cpu): `all` means 0..N-1 and each worker's CUDA_VISIBLE_DEVICES names its fake device."""
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from typing import List
+
+from kage.bench import tasks
+
+FAKE_GPUS = "KAGE_BENCH_FAKE_GPUS"
+
+
+def device_count() -> int:
+    fake = os.environ.get(FAKE_GPUS)
+    if fake is not None:
+        if not fake.isdigit():
+            raise SystemExit(f"kage.bench run: {FAKE_GPUS}={fake!r}: a number of fake GPUs (for tests)")
+        return int(fake)
+    import torch
+    return torch.cuda.device_count()
+
+
+def parse_gpus(text: str, trainer_device: str) -> List[str]:
+    """'all' or '0,2' -> the CUDA_VISIBLE_DEVICES value of each worker. Indices count the GPUs this process
+    sees, so under an outer CUDA_VISIBLE_DEVICES (a Slurm allocation) index 0 is its first GPU."""
+    count = device_count()
+    if count == 0:
+        raise SystemExit("kage.bench run: --gpus, but torch sees no CUDA GPU: run without --gpus (one process)")
+    if trainer_device != "cuda" and os.environ.get(FAKE_GPUS) is None:
+        raise SystemExit(f"kage.bench run: --gpus trains on the GPUs: remove --device {trainer_device}, or --gpus")
+    if text == "all":
+        indices = list(range(count))
+    else:
+        try:
+            indices = [int(part) for part in text.split(",")]
+        except ValueError:
+            raise SystemExit(f"kage.bench run: --gpus {text}: use 'all' or GPU indices like 0,2") from None
+        bad = [i for i in indices if not 0 <= i < count]
+        if bad or len(set(indices)) != len(indices):
+            raise SystemExit(f"kage.bench run: --gpus {text}: this machine's GPUs are 0 to {count - 1}, each named "
+                             "once")
+    outer = os.environ.get("CUDA_VISIBLE_DEVICES")
+    visible = outer.split(",") if outer and os.environ.get(FAKE_GPUS) is None else None
+    return [visible[i] if visible else str(i) for i in indices]
+
+
+def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
+    """Trains the unfinished tasks of `table`, one worker per device; prints each task's start and end."""
+    todo = [i for i, task in enumerate(table) if not all(map(tasks.is_finished, task))]
+    print(f"kage.bench run: {len(table)} tasks, {len(table) - len(todo)} finished earlier; {len(todo)} to train on "
+          f"GPUs {','.join(devices)}", file=sys.stderr, flush=True)
+    log_dir = os.path.join(bench.out, "tasks")
+    os.makedirs(log_dir, exist_ok=True)
+    lock = threading.Lock()
+    children = {}
+    failed: List[int] = []
+    stopping = threading.Event()
+    started = time.monotonic()
+    done = [0]
+
+    def worker(device: str) -> None:
+        while True:
+            with lock:
+                if stopping.is_set() or not todo:
+                    return
+                index = todo.pop(0)
+                print(f"[gpu {device}] task {index}: {tasks.describe(table[index])}", file=sys.stderr, flush=True)
+                log = open(os.path.join(log_dir, f"task_{index}.log"), "ab")
+                children[device] = subprocess.Popen([*bench.run_command(), "--task", str(index)], stdout=log,
+                                                    stderr=log, env={**os.environ, "CUDA_VISIBLE_DEVICES": device})
+            code = children[device].wait()
+            log.close()
+            with lock:
+                done[0] += 1
+                if code != 0 and not stopping.is_set():
+                    failed.append(index)
+                left = len(todo) + sum(c.poll() is None for c in children.values())
+                eta = (time.monotonic() - started) / done[0] * left
+                status = ("done" if code == 0 else "stopped" if stopping.is_set()
+                          else f"FAILED (exit {code}); see {log.name}")
+                print(f"[gpu {device}] task {index}: {status} · tasks left {left} · ETA {eta / 60:,.0f} min",
+                      file=sys.stderr, flush=True)
+
+    threads = [threading.Thread(target=worker, args=(d,), daemon=True) for d in devices]
+    for thread in threads:
+        thread.start()
+    try:
+        while any(t.is_alive() for t in threads):
+            time.sleep(0.5)
+    except BaseException:  # Stop (SIGTERM) or Ctrl-C: the children stop their runs and keep the checkpoints
+        stopping.set()
+        with lock:
+            for child in children.values():
+                if child.poll() is None:
+                    child.send_signal(signal.SIGTERM)
+        for thread in threads:
+            thread.join(timeout=60)
+        print("kage.bench run: stopped; run again to resume", file=sys.stderr, flush=True)
+        return 128 + signal.SIGTERM
+    if failed:
+        print(f"kage.bench run: task(s) {', '.join(map(str, sorted(failed)))} failed (kage.bench status "
+              f"{bench.out}); rerun to resume them", file=sys.stderr)
+        return 1
+    print(f"kage.bench run: {sum(map(len, table))} runs in {bench.out}; tables and plots: "
+          f"python3 -m kage.bench report {bench.out}", file=sys.stderr)
+    return 0

@@ -1,0 +1,46 @@
+"""What the runner knows about each run of a benchmark, for `kage.bench status`: RUN_DIR/bench_state.json
+holds "running" (with a heartbeat the runner refreshes while the run trains), "failed" (exit code, log,
+the log's last error line) or "stopped" (the runner was told to stop: Slurm's scancel, preemption, Ctrl-C).
+A run whose heartbeat is older than STALE_S was killed without a word (SIGKILL, a lost node); a run with
+summary.json is finished whatever its state file says."""
+import json
+import os
+import socket
+import time
+from typing import List, Optional
+
+from kage.files import write_json
+
+STATE_FILE = "bench_state.json"
+HEARTBEAT_S = 30.0
+STALE_S = 4 * HEARTBEAT_S
+
+
+def where() -> dict:
+    """The host, process and device a run is trained by."""
+    return {"host": socket.gethostname(), "pid": os.getpid(), "gpu": os.environ.get("CUDA_VISIBLE_DEVICES"),
+            "slurm_job": os.environ.get("SLURM_ARRAY_JOB_ID") or os.environ.get("SLURM_JOB_ID")}
+
+
+def mark(run_dirs: List[str], state: str, **details) -> None:
+    for run_dir in run_dirs:
+        write_json(os.path.join(run_dir, STATE_FILE), {"state": state, "time": time.time(), **where(), **details})
+
+
+def last_error(log_path: str) -> str:
+    """The last non-empty line of a log: a traceback's exception, or kage.train's message."""
+    try:
+        with open(log_path, "rb") as f:
+            f.seek(max(0, os.path.getsize(log_path) - 16384))
+            lines = [line.strip() for line in f.read().decode(errors="replace").splitlines() if line.strip()]
+    except OSError as e:
+        return f"(no log: {e.strerror})"
+    return lines[-1][:500] if lines else "(the log is empty)"
+
+
+def read(run_dir: str) -> Optional[dict]:
+    try:
+        with open(os.path.join(run_dir, STATE_FILE)) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None

@@ -1,0 +1,62 @@
+"""python3 -m kage.bench status DIR: where a benchmark stands, from the files its processes write (any
+number of them, on any hosts: a Slurm array, GPU workers, plain runs): runs done, running, failed (with
+the last error of each), stopped or killed (they resume when run again), and not started."""
+import json
+import os
+import time
+from typing import Dict, List, TextIO
+
+from kage.bench import run_state
+from kage.bench.run import checkpoint_iteration
+from kage.bench.tasks import run_dir
+
+ORDER = ("done", "running", "failed", "interrupted", "not started")
+
+
+def classify(path: str, now: float) -> tuple:
+    """(category, detail) of one run directory."""
+    if os.path.exists(os.path.join(path, "summary.json")):
+        return "done", ""
+    state = run_state.read(path)
+    iteration = checkpoint_iteration(path)
+    at = f"checkpoint at iteration {iteration}" if iteration else "no checkpoint yet"
+    if state is None:
+        return ("interrupted", at) if iteration else ("not started", "")
+    where = f"host {state['host']}" + (f", task {state['task']}" if state.get("task") is not None else "") + \
+        (f", GPU {state['gpu']}" if state.get("gpu") else "") + \
+        (f", Slurm job {state['slurm_job']}" if state.get("slurm_job") else "")
+    age = now - state["time"]
+    if state["state"] == "running" and age <= run_state.STALE_S:
+        return "running", f"{at}; {where}"
+    if state["state"] == "failed":
+        return "failed", f"exit {state['exit_code']} ({where}, log {state['log']}): {state['error']}"
+    if state["state"] == "running":
+        return "interrupted", f"no heartbeat for {age / 60:,.0f} min (killed?); {at}; {where}"
+    if state["state"] == "stopped":
+        return "interrupted", f"stopped {age / 60:,.0f} min ago; {at}; {where}"
+    return "interrupted", f"{at}; {where}"  # "done" without summary.json: ended early
+
+
+def status(bench_dir: str, out: TextIO) -> Dict[str, List[str]]:
+    """Prints the benchmark's state; returns category -> the runs in it."""
+    try:
+        with open(os.path.join(bench_dir, "bench.json")) as f:
+            bench = json.load(f)
+    except (OSError, ValueError) as e:
+        raise SystemExit(f"{os.path.join(bench_dir, 'bench.json')}: error: {getattr(e, 'strerror', None) or e}: "
+                         "not a directory written by python3 -m kage.bench run (or slurm)") from None
+    now = time.time()
+    found: Dict[str, List[tuple]] = {c: [] for c in ORDER}
+    for unit in bench["units"]:
+        for seed in bench["seeds"]:
+            category, detail = classify(run_dir(bench_dir, unit, seed), now)
+            found[category].append((f"{unit} seed {seed}", detail))
+    total = sum(map(len, found.values()))
+    out.write(f"{bench_dir}: {total} runs: " + ", ".join(f"{len(found[c])} {c}" for c in ORDER) + "\n")
+    for category in ORDER[1:-1]:
+        if found[category]:
+            out.write(f"{category}:\n" + "".join(f"  {name}: {detail}\n" for name, detail in found[category]))
+    if found["interrupted"]:
+        out.write("interrupted runs resume from their checkpoints when their task runs again "
+                  "(kage.bench run, or the Slurm array task)\n")
+    return {c: [name for name, _ in runs] for c, runs in found.items()}

@@ -1,0 +1,75 @@
+"""kage.bench run --gpus on the CPU, with fake devices (KAGE_BENCH_FAKE_GPUS): one worker per device takes
+tasks until none is left, each task's process sees its own device, a rerun trains nothing, and one report
+covers every task's runs; the device list is checked and follows an outer CUDA_VISIBLE_DEVICES."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from kage.bench import gpus, run
+from support import ROOT, TINY_TRAINING
+
+PAIRS = ["background/1", "agent_appearance/1", "distractors/1"]
+
+
+def bench(*args, fake_gpus="2"):
+    env = {**os.environ, "KAGE_BENCH_FAKE_GPUS": fake_gpus}
+    env.pop("CUDA_VISIBLE_DEVICES", None)
+    return subprocess.run([sys.executable, "-m", "kage.bench", *args], cwd=ROOT, capture_output=True, text=True,
+                          timeout=900, env=env)
+
+
+def test_two_fake_gpus_train_three_tasks(tmp_path):
+    out = tmp_path / "bench"
+    args = ["run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out), *TINY_TRAINING]
+    first = bench(*args, "--gpus", "all")
+    assert first.returncode == 0, first.stderr
+    assert "3 tasks, 0 finished earlier; 3 to train on GPUs 0,1" in first.stderr
+    devices = {}
+    for task, pair in enumerate(PAIRS):
+        run_dir = out / "runs" / pair / "seed_1"
+        assert (run_dir / "summary.json").exists(), (out / "tasks" / f"task_{task}.log").read_text()
+        state = json.loads((run_dir / "bench_state.json").read_text())
+        assert state["state"] == "done" and state["task"] == task
+        devices[task] = state["gpu"]
+    assert devices[0] != devices[1] and set(devices.values()) == {"0", "1"}  # both workers start at once
+    assert first.stderr.count(": done · tasks left") == 3
+
+    again = bench(*args, "--gpus", "0,1")
+    assert again.returncode == 0 and "3 tasks, 3 finished earlier; 0 to train" in again.stderr, again.stderr
+
+    reported = bench("report", str(out))
+    assert reported.returncode == 0, reported.stderr
+    report = json.loads((out / "report" / "report.json").read_text())
+    assert {p["pair"]: p["n_seeds"] for p in report["levels"]["pairs"]} == {p: 1 for p in PAIRS}
+    status = bench("status", str(out))
+    assert "3 runs: 3 done, 0 running, 0 failed, 0 interrupted, 0 not started" in status.stdout
+
+
+def test_the_device_list_is_checked(monkeypatch):
+    monkeypatch.delenv("CUDA_VISIBLE_DEVICES", raising=False)
+    monkeypatch.setenv(gpus.FAKE_GPUS, "3")
+    assert gpus.parse_gpus("all", "cpu") == ["0", "1", "2"]
+    assert gpus.parse_gpus("2,0", "cpu") == ["2", "0"]
+    for text, message in (("0,3", "this machine's GPUs are 0 to 2"), ("0,0", "each named once"),
+                          ("first", "use 'all' or GPU indices like 0,2")):
+        with pytest.raises(SystemExit, match=message):
+            gpus.parse_gpus(text, "cpu")
+    monkeypatch.setenv(gpus.FAKE_GPUS, "0")
+    with pytest.raises(SystemExit, match="torch sees no CUDA GPU"):
+        gpus.parse_gpus("all", "cpu")
+    with pytest.raises(SystemExit, match="--task and --gpus exclude each other"):
+        run.main(["suites/kage_bench.yaml", "--out", "unused", "--gpus", "all", "--task", "0"])
+
+
+def test_an_outer_allocation_maps_the_indices(monkeypatch):
+    """Under Slurm's (or anyone's) CUDA_VISIBLE_DEVICES, index i is the i-th GPU this process sees."""
+    monkeypatch.delenv(gpus.FAKE_GPUS, raising=False)
+    monkeypatch.setenv("CUDA_VISIBLE_DEVICES", "3,5")
+    monkeypatch.setattr(gpus, "device_count", lambda: 2)
+    assert gpus.parse_gpus("all", "cuda") == ["3", "5"]
+    assert gpus.parse_gpus("1", "cuda") == ["5"]
+    with pytest.raises(SystemExit, match="remove --device cpu, or --gpus"):
+        gpus.parse_gpus("all", "cpu")
