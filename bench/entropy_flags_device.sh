@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# One device-machine call: which speed flag lowers the policy's entropy? Seed 1 of background/1 alone,
+# once per flag (fp32, --bf16, --channels-last, --fused-input), STEPS steps (default 2,621,440), all at
+# once; prints the entropy every 20 iterations and the evaluation points. Carry [".deps"].
+set -uo pipefail
+source bench/device_build.sh
+dir=/tmp/kage-entropy
+rm -rf "$dir"
+for flag in fp32 bf16 channels-last fused-input; do
+  extra=()
+  [[ $flag != fp32 ]] && extra=("--$flag")
+  python3 -m kage.train --train-config-path configs/kage_bench/bases/shape_black.yaml \
+    --eval-config-path configs/kage_bench/background/1-eval.yaml --seed 1 --out "$dir/$flag" --device cuda \
+    --total-timesteps "${STEPS:-2621440}" --run-eval-every 40 "${extra[@]}" >"$dir-$flag.log" 2>&1 &
+done
+wait
+python3 - "$dir" <<'PY'
+import glob, json, os, sys
+for path in sorted(glob.glob(os.path.join(sys.argv[1], "*", "metrics.jsonl"))):
+    rows = [json.loads(l) for l in open(path)]
+    evals = "  ".join(f"{r['iteration']}: {r['train']['return']:.0f} ({r['train']['success_once']:.2f})"
+                      for r in rows if r["kind"] == "eval")
+    entropy = " ".join(f"{r['losses/entropy']:.2f}" for r in rows if r["kind"] == "train" and r["iteration"] % 20 == 0)
+    print(f"{os.path.basename(os.path.dirname(path))}\n  eval {evals}\n  entropy/20 it {entropy}")
+PY
