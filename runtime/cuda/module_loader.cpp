@@ -83,7 +83,15 @@ std::optional<std::string> cache_lookup(const fs::path& file, const std::string&
   return text.substr(header.size());
 }
 
-/// Compiles `source` to a cubin for sm_<major><minor>.
+}  // namespace
+
+std::vector<std::string> nvrtc_option_list(const std::string& arch, const NvrtcOptions& options) {
+  std::vector<std::string> opts = {"--gpu-architecture=" + arch, "-std=c++20", "--fmad=false",
+                                   "-I" + options.include_dir};
+  opts.insert(opts.end(), options.extra_options.begin(), options.extra_options.end());
+  return opts;
+}
+
 std::optional<std::string> nvrtc_compile(const std::string& source, const std::string& name,
                                          const std::vector<std::string>& options, std::string* error) {
   nvrtcProgram prog;
@@ -122,8 +130,6 @@ std::optional<std::string> nvrtc_compile(const std::string& source, const std::s
   }
   return cubin;
 }
-
-}  // namespace
 
 std::string cu_error_text(CUresult r, const char* what) {
   if (r == CUDA_SUCCESS) return {};
@@ -200,9 +206,7 @@ std::optional<CudaModule> CudaModule::compile(const std::string& source, const s
     return std::nullopt;
   }
   const std::string arch = "sm_" + std::to_string(major) + std::to_string(minor);
-  std::vector<std::string> opts = {"--gpu-architecture=" + arch, "-std=c++20", "--fmad=false",
-                                   "-I" + options.include_dir};
-  opts.insert(opts.end(), options.extra_options.begin(), options.extra_options.end());
+  const std::vector<std::string> opts = nvrtc_option_list(arch, options);
 
   int nv_major = 0, nv_minor = 0;
   const nvrtcResult vr = nvrtcVersion(&nv_major, &nv_minor);

@@ -28,6 +28,14 @@ struct NvrtcOptions {
   std::vector<std::string> extra_options;
 };
 
+/// The NVRTC options of a run-time compilation for `arch` (e.g. "sm_90"): the one list that the
+/// loader uses and that tests/cuda/nvrtc_check.cpp compiles with.
+std::vector<std::string> nvrtc_option_list(const std::string& arch, const NvrtcOptions& options);
+
+/// Compiles `source` with NVRTC to a cubin (no driver, no GPU needed); null with the log in `error`.
+std::optional<std::string> nvrtc_compile(const std::string& source, const std::string& name,
+                                         const std::vector<std::string>& options, std::string* error);
+
 /// Where the cubin cache lives: $KAGE_CACHE_DIR, else ~/.cache/kagec; empty when KAGE_CACHE=off.
 std::string kernel_cache_dir();
 
