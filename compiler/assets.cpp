@@ -5,11 +5,14 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <sstream>
 
 #include "compiler/key_refs.h"
 #include "compiler/utf8.h"
 #include "runtime/host/asset_scan.h"
+#include "runtime/host/image_io.h"
 #include "runtime/host/sha256.h"
 
 namespace kage {
@@ -118,6 +121,10 @@ class AssetResolver {
     }
     std::ostringstream buf;
     buf << in.rdbuf();
+    if (in.bad()) {
+      diags_.report(Rule::AssetUnreadable, at, "asset file '" + file + "' cannot be read; check it", pointer_of(key));
+      return std::nullopt;
+    }
     const std::string bytes = buf.str();
     int w = 0, h = 0, c = 0;
     if (!stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), static_cast<int>(bytes.size()), &w, &h,
@@ -129,7 +136,29 @@ class AssetResolver {
                     pointer_of(key));
       return std::nullopt;
     }
-    return AssetFile{display_path(file), sha256_hex(bytes), w, h};
+    const std::string hash = sha256_hex(bytes);
+    // Decoded as the runtime will decode it (a header can be fine and the data truncated).
+    if (const std::string problem = decode_problem(hash, bytes); !problem.empty()) {
+      diags_.report(Rule::AssetUnreadable, at, "asset file '" + file + "' cannot be decoded: " + problem + "; replace it",
+                    pointer_of(key));
+      return std::nullopt;
+    }
+    return AssetFile{display_path(file), hash, w, h};
+  }
+
+  // What the runtime's decoder says about these bytes ("" when they decode), remembered by content
+  // hash: a suite or a fuzz run names the same images many times.
+  static std::string decode_problem(const std::string& hash, const std::string& bytes) {
+    static std::mutex mutex;
+    static std::map<std::string, std::string> known;
+    {
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (const auto it = known.find(hash); it != known.end()) return it->second;
+    }
+    const ImageResult r = decode_image(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), 3, "");
+    std::string problem = r.ok() ? std::string() : r.error.substr(r.error.find_first_not_of(": "));
+    const std::lock_guard<std::mutex> lock(mutex);
+    return known.emplace(hash, std::move(problem)).first->second;
   }
 
   void resolve_backgrounds(const AssetGroupRef& g) {
@@ -146,10 +175,12 @@ class AssetResolver {
     if (list.is_array() && !list.empty()) {
       for (size_t i = 0; i < list.size(); ++i) files.push_back({list[i].get<std::string>(), item_range(paths_key, i), paths_key});
     } else if (const Json& dir = spec_.value(dir_key); dir.is_string()) {
-      const auto found = scan_background_dir(dir.get<std::string>());
+      std::string bound;
+      const auto found = scan_background_dir(dir.get<std::string>(), &bound);
       if (!found) {
-        diags_.report(Rule::AssetMissing, range_of(dir_key),
-                      "background folder '" + dir.get<std::string>() + "' does not exist; fix the path",
+        diags_.report(bound.empty() ? Rule::AssetMissing : Rule::AssetUnreadable, range_of(dir_key),
+                      bound.empty() ? "background folder '" + dir.get<std::string>() + "' does not exist; fix the path"
+                                    : "background folder " + bound,
                       pointer_of(dir_key));
         return;
       }
@@ -181,7 +212,12 @@ class AssetResolver {
     const Json& list = spec_.value(g.sources[1]);
     const Json& single = spec_.value(g.sources[2]);
     if (parent.is_string()) {
-      const auto found = scan_skin_parent(parent.get<std::string>());
+      std::string bound;
+      const auto found = scan_skin_parent(parent.get<std::string>(), &bound);
+      if (!found && !bound.empty()) {
+        diags_.report(Rule::AssetUnreadable, range_of(g.sources[0]), "sprite folder " + bound, pointer_of(g.sources[0]));
+        return;
+      }
       if (!found) {
         diags_.report(Rule::AssetMissing, range_of(g.sources[0]),
                       "sprite folder '" + parent.get<std::string>() +
@@ -213,7 +249,13 @@ class AssetResolver {
       }
       AssetSet set;
       set.dir = display_path(dir);
-      for (const std::string& frame : scan_skin_frames(dir))
+      std::string bound;
+      const std::vector<std::string> frames = scan_skin_frames(dir, &bound);
+      if (!bound.empty()) {
+        diags_.report(Rule::AssetUnreadable, at, "sprite folder " + bound, pointer_of(key));
+        continue;
+      }
+      for (const std::string& frame : frames)
         if (auto f = hash_image(frame, at, key)) set.frames.push_back(*f);
       if (set.frames.empty()) {
         diags_.report(Rule::AssetEmpty, at, "sprite folder '" + dir + "' holds no PNG frames; add frames or remove it",

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include "compiler/compose.h"
+#include "compiler/diag.h"
 #include "test_support.h"
 
 namespace kage::test {
@@ -95,6 +96,45 @@ TEST_CASE("a deep extends chain ends in an error at its limit, without recursion
   INFO(b.dump());
   REQUIRE(b.spec);
   CHECK(b.spec->values.at("H") == 64);
+}
+
+}  // namespace kage::test
+
+namespace kage::test {
+
+TEST_CASE("control characters in file names are escaped in diagnostics", "[hostile][assets]") {
+  TempDir tmp("hostile_names");
+  const std::string name = "bg\x1b[31mred\n.png";
+  write_text(tmp.path() / name, "not an image");
+  write_text(tmp.path() / "c.yaml", "background:\n  mode: image\n  image_path: \"bg\\e[31mred\\n.png\"\n");
+  Analysis a;
+  DiskFileReader reader;
+  analyze(a, (tmp.path() / "c.yaml").string(), reader);
+  REQUIRE(a.count("asset-unreadable") == 1);
+  std::ostringstream text;
+  print_text(a.diags, text);
+  INFO(text.str());
+  CHECK(text.str().find("bg\\x1b[31mred\\x0a.png") != std::string::npos);
+  CHECK(text.str().find('\x1b') == std::string::npos);
+}
+
+TEST_CASE("asset scans stop at their bounds with an error", "[hostile][assets]") {
+  TempDir tmp("hostile_scan");
+  fs::path deep = tmp.path() / "deep" / "skin";
+  for (int i = 0; i < 10; ++i) deep /= "d";
+  fs::create_directories(deep);
+  write_text(deep / "frame.png", "x");
+  fs::create_directories(tmp.path() / "wide");
+  for (int i = 0; i <= 10000; ++i) std::ofstream(tmp.path() / "wide" / (std::to_string(i) + ".png"));
+  write_text(tmp.path() / "c.yaml",
+             "background: {mode: image, image_dir: wide}\n"
+             "character: {use_sprites: true, use_shape: false, sprite_dir: deep}\n");
+  Analysis a;
+  DiskFileReader reader;
+  analyze(a, (tmp.path() / "c.yaml").string(), reader);
+  INFO(a.dump());
+  CHECK(a.dump().find("/wide' holds more than 10000 entries; point at a folder of assets") != std::string::npos);
+  CHECK(a.dump().find("/deep/skin' is nested deeper than 8 levels; point at a folder of assets") != std::string::npos);
 }
 
 }  // namespace kage::test
