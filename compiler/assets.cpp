@@ -62,11 +62,41 @@ class AssetResolver {
       if (!entry) continue;
       Json& v = k.section.empty() ? spec_.values[k.name] : spec_.values[k.section][k.name];
       const std::string base = base_dir(entry->value);
-      if (v.is_string()) v = display_path(join_path(base, v.get<std::string>()));
+      if (v.is_string()) v = locate(base, v.get<std::string>(), entry->value.range, k);
       if (v.is_array())
-        for (Json& item : v)
-          if (item.is_string()) item = display_path(join_path(base, item.get<std::string>()));
+        for (size_t i = 0; i < v.size(); ++i)
+          if (v[i].is_string()) {
+            const Range at = i < entry->value.items.size() ? entry->value.items[i].range : entry->value.range;
+            v[i] = locate(base, v[i].get<std::string>(), at, k);
+          }
     }
+  }
+
+  // A relative path is taken next to the file that writes it. The original takes it from the working
+  // directory, so its own configs name paths like src/kage_bench/assets/...: such a path that exists
+  // only under the working directory is used from there (with a note), and one that names two
+  // different files is a warning. The Spec identifies assets by content, so either way the hash
+  // does not depend on where the command ran.
+  std::string locate(const std::string& base, const std::string& path, Range at, const KeySchema& k) {
+    const std::string here = display_path(join_path(base, path));
+    if (options_.asset_root || fs::path(path).is_absolute()) return here;
+    const std::string cwd = display_path(path);
+    if (cwd == here) return here;
+    std::error_code ec;
+    const bool here_exists = fs::exists(here, ec), cwd_exists = fs::exists(cwd, ec);
+    if (here_exists && cwd_exists && !fs::equivalent(here, cwd, ec)) {
+      diags_.report(Rule::AssetAmbiguous, at,
+                    "asset path '" + path + "' names '" + here + "' next to the config, which is used, and '" + cwd +
+                        "' under the working directory, where the original looks; pass --asset-root to choose",
+                    k.pointer);
+    } else if (!here_exists && cwd_exists) {
+      diags_.report(Rule::AssetCwdRelative, at,
+                    "asset path '" + path + "' is not next to the config; using '" + cwd +
+                        "' under the working directory, as the original does",
+                    k.pointer);
+      return cwd;
+    }
+    return here;
   }
 
   std::string base_dir(const DocNode& node) const {
