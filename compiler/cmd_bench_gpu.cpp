@@ -28,11 +28,15 @@ namespace {
 
 /// A manifest names its suite at the top level; a config never has that key.
 bool is_suite_manifest(const std::string& path) {
+  DiskFileReader reader;  // regular files only: a FIFO or device must not hang or flood this probe
+  std::string error;
+  const std::optional<std::string> text = reader.read(path, &error);
+  if (!text) return false;  // the config path reports the error with its diagnostics
   try {
-    const YAML::Node doc = YAML::LoadFile(path);
+    const YAML::Node doc = YAML::Load(*text);
     return doc.IsMap() && doc["suite"];
   } catch (const YAML::Exception&) {
-    return false;  // the config path reports the error with its diagnostics
+    return false;
   }
 }
 

@@ -182,6 +182,12 @@ TEST_CASE("diff: every order of the files, --certify, the axis and -o gives the 
   }
 }
 
+TEST_CASE("resolve -o reports a write that fails", "[cli][resolve]") {
+  const CliRun full = kagec({"resolve", "tests/lint/no-diagnostics.yaml", "-o", "/dev/full"});
+  CHECK(full.code == 1);
+  CHECK(full.err.find("kagec resolve: cannot write '/dev/full': write failed") != std::string::npos);
+}
+
 TEST_CASE("diff -o reports a write that fails", "[cli][diff]") {
   const CliRun full = kagec({"diff", "configs/kage_bench/bases/shape_black.yaml",
                              "configs/kage_bench/background/1-eval.yaml", "--certify", "-o", "/dev/full"});
