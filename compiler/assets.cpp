@@ -5,11 +5,14 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <sstream>
 
 #include "compiler/key_refs.h"
 #include "compiler/utf8.h"
 #include "runtime/host/asset_scan.h"
+#include "runtime/host/image_io.h"
 #include "runtime/host/sha256.h"
 
 namespace kage {
@@ -59,11 +62,41 @@ class AssetResolver {
       if (!entry) continue;
       Json& v = k.section.empty() ? spec_.values[k.name] : spec_.values[k.section][k.name];
       const std::string base = base_dir(entry->value);
-      if (v.is_string()) v = display_path(join_path(base, v.get<std::string>()));
+      if (v.is_string()) v = locate(base, v.get<std::string>(), entry->value.range, k);
       if (v.is_array())
-        for (Json& item : v)
-          if (item.is_string()) item = display_path(join_path(base, item.get<std::string>()));
+        for (size_t i = 0; i < v.size(); ++i)
+          if (v[i].is_string()) {
+            const Range at = i < entry->value.items.size() ? entry->value.items[i].range : entry->value.range;
+            v[i] = locate(base, v[i].get<std::string>(), at, k);
+          }
     }
+  }
+
+  // A relative path is taken next to the file that writes it. The original takes it from the working
+  // directory, so its own configs name paths like src/kage_bench/assets/...: such a path that exists
+  // only under the working directory is used from there (with a note), and one that names two
+  // different files is a warning. The Spec identifies assets by content, so either way the hash
+  // does not depend on where the command ran.
+  std::string locate(const std::string& base, const std::string& path, Range at, const KeySchema& k) {
+    const std::string here = display_path(join_path(base, path));
+    if (options_.asset_root || fs::path(path).is_absolute()) return here;
+    const std::string cwd = display_path(path);
+    if (cwd == here) return here;
+    std::error_code ec;
+    const bool here_exists = fs::exists(here, ec), cwd_exists = fs::exists(cwd, ec);
+    if (here_exists && cwd_exists && !fs::equivalent(here, cwd, ec)) {
+      diags_.report(Rule::AssetAmbiguous, at,
+                    "asset path '" + path + "' names '" + here + "' next to the config, which is used, and '" + cwd +
+                        "' under the working directory, where the original looks; pass --asset-root to choose",
+                    k.pointer);
+    } else if (!here_exists && cwd_exists) {
+      diags_.report(Rule::AssetCwdRelative, at,
+                    "asset path '" + path + "' is not next to the config; using '" + cwd +
+                        "' under the working directory, as the original does",
+                    k.pointer);
+      return cwd;
+    }
+    return here;
   }
 
   std::string base_dir(const DocNode& node) const {
@@ -118,6 +151,10 @@ class AssetResolver {
     }
     std::ostringstream buf;
     buf << in.rdbuf();
+    if (in.bad()) {
+      diags_.report(Rule::AssetUnreadable, at, "asset file '" + file + "' cannot be read; check it", pointer_of(key));
+      return std::nullopt;
+    }
     const std::string bytes = buf.str();
     int w = 0, h = 0, c = 0;
     if (!stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), static_cast<int>(bytes.size()), &w, &h,
@@ -129,7 +166,29 @@ class AssetResolver {
                     pointer_of(key));
       return std::nullopt;
     }
-    return AssetFile{display_path(file), sha256_hex(bytes), w, h};
+    const std::string hash = sha256_hex(bytes);
+    // Decoded as the runtime will decode it (a header can be fine and the data truncated).
+    if (const std::string problem = decode_problem(hash, bytes); !problem.empty()) {
+      diags_.report(Rule::AssetUnreadable, at, "asset file '" + file + "' cannot be decoded: " + problem + "; replace it",
+                    pointer_of(key));
+      return std::nullopt;
+    }
+    return AssetFile{display_path(file), hash, w, h};
+  }
+
+  // What the runtime's decoder says about these bytes ("" when they decode), remembered by content
+  // hash: a suite or a fuzz run names the same images many times.
+  static std::string decode_problem(const std::string& hash, const std::string& bytes) {
+    static std::mutex mutex;
+    static std::map<std::string, std::string> known;
+    {
+      const std::lock_guard<std::mutex> lock(mutex);
+      if (const auto it = known.find(hash); it != known.end()) return it->second;
+    }
+    const ImageResult r = decode_image(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), 3, "");
+    std::string problem = r.ok() ? std::string() : r.error.substr(r.error.find_first_not_of(": "));
+    const std::lock_guard<std::mutex> lock(mutex);
+    return known.emplace(hash, std::move(problem)).first->second;
   }
 
   void resolve_backgrounds(const AssetGroupRef& g) {
@@ -146,10 +205,12 @@ class AssetResolver {
     if (list.is_array() && !list.empty()) {
       for (size_t i = 0; i < list.size(); ++i) files.push_back({list[i].get<std::string>(), item_range(paths_key, i), paths_key});
     } else if (const Json& dir = spec_.value(dir_key); dir.is_string()) {
-      const auto found = scan_background_dir(dir.get<std::string>());
+      std::string bound;
+      const auto found = scan_background_dir(dir.get<std::string>(), &bound);
       if (!found) {
-        diags_.report(Rule::AssetMissing, range_of(dir_key),
-                      "background folder '" + dir.get<std::string>() + "' does not exist; fix the path",
+        diags_.report(bound.empty() ? Rule::AssetMissing : Rule::AssetUnreadable, range_of(dir_key),
+                      bound.empty() ? "background folder '" + dir.get<std::string>() + "' does not exist; fix the path"
+                                    : "background folder " + bound,
                       pointer_of(dir_key));
         return;
       }
@@ -181,7 +242,12 @@ class AssetResolver {
     const Json& list = spec_.value(g.sources[1]);
     const Json& single = spec_.value(g.sources[2]);
     if (parent.is_string()) {
-      const auto found = scan_skin_parent(parent.get<std::string>());
+      std::string bound;
+      const auto found = scan_skin_parent(parent.get<std::string>(), &bound);
+      if (!found && !bound.empty()) {
+        diags_.report(Rule::AssetUnreadable, range_of(g.sources[0]), "sprite folder " + bound, pointer_of(g.sources[0]));
+        return;
+      }
       if (!found) {
         diags_.report(Rule::AssetMissing, range_of(g.sources[0]),
                       "sprite folder '" + parent.get<std::string>() +
@@ -213,7 +279,13 @@ class AssetResolver {
       }
       AssetSet set;
       set.dir = display_path(dir);
-      for (const std::string& frame : scan_skin_frames(dir))
+      std::string bound;
+      const std::vector<std::string> frames = scan_skin_frames(dir, &bound);
+      if (!bound.empty()) {
+        diags_.report(Rule::AssetUnreadable, at, "sprite folder " + bound, pointer_of(key));
+        continue;
+      }
+      for (const std::string& frame : frames)
         if (auto f = hash_image(frame, at, key)) set.frames.push_back(*f);
       if (set.frames.empty()) {
         diags_.report(Rule::AssetEmpty, at, "sprite folder '" + dir + "' holds no PNG frames; add frames or remove it",

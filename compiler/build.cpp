@@ -84,7 +84,22 @@ std::string find_host_cxx() {
 
 std::string runtime_include_dir() {
   const std::string root = env("KAGE_ROOT");
-  return root.empty() ? std::string(KAGE_SOURCE_ROOT) : root;
+  if (!root.empty()) return root;
+  // An installed binary (kagec, or a library linked into a program) finds the headers that
+  // `cmake --install` put beside it: <prefix>/bin/kagec -> <prefix>/share/kagec/runtime.
+  // The binary is the running program, or the shared object this code was linked into.
+  std::vector<std::string> binaries = {"/proc/self/exe"};
+  Dl_info info{};
+  if (::dladdr(reinterpret_cast<const void*>(&runtime_include_dir), &info) && info.dli_fname && *info.dli_fname)
+    binaries.push_back(info.dli_fname);
+  for (const std::string& b : binaries) {
+    std::error_code ec;
+    const fs::path binary = fs::canonical(b, ec);
+    if (ec) continue;
+    const fs::path installed = binary.parent_path().parent_path() / "share" / "kagec";
+    if (fs::is_regular_file(installed / "runtime" / "kage_hd.h", ec)) return installed.string();
+  }
+  return KAGE_SOURCE_ROOT;  // the source tree of a build that was not installed
 }
 
 ToolRun run_tool(const std::vector<std::string>& argv) {

@@ -23,8 +23,9 @@ std::string join_flags(const std::vector<std::string>& flags);
 std::string find_nvcc();
 /// The host compiler: $KAGE_HOST_CXX, $CXX, then `c++` on PATH. Empty if none.
 std::string find_host_cxx();
-/// The directory the generated source's #include "runtime/..." resolve against: $KAGE_ROOT, else the
-/// source tree kagec was built from.
+/// The directory the generated source's #include "runtime/..." resolve against: $KAGE_ROOT, else
+/// <prefix>/share/kagec beside an installed binary (<prefix>/bin or <prefix>/lib), else the source
+/// tree kagec was built from.
 std::string runtime_include_dir();
 
 /// First line of `tool --version` (empty if it cannot run).

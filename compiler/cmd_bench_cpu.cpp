@@ -57,13 +57,15 @@ int cmd_bench(const std::vector<std::string>& args, CommandIo& io) {
   std::vector<uint64_t> seeds(envs);
   for (int i = 0; i < envs; ++i) seeds[i] = static_cast<uint64_t>(i);
   env.reset(seeds.data());
-  // Uniform random actions, drawn before timing so that only the environment is measured.
-  const int total = warmup + steps;
-  std::vector<int32_t> actions(static_cast<size_t>(total) * envs);
+  // Uniform random actions, drawn before timing so that only the environment is measured; a ring of
+  // kActionSteps steps bounds their memory whatever --steps is.
+  constexpr int64_t kActionSteps = 64;
+  std::vector<int32_t> actions(static_cast<size_t>(kActionSteps) * envs);
   for (size_t i = 0; i < actions.size(); ++i) actions[i] = randint(Key{0, 1}, static_cast<uint32_t>(i), 0, 8);
-  for (int t = 0; t < warmup; ++t) env.step(actions.data() + static_cast<size_t>(t) * envs);
+  auto step = [&](int64_t t) { env.step(actions.data() + static_cast<size_t>(t % kActionSteps) * envs); };
+  for (int64_t t = 0; t < warmup; ++t) step(t);
   const auto start = std::chrono::steady_clock::now();
-  for (int t = warmup; t < total; ++t) env.step(actions.data() + static_cast<size_t>(t) * envs);
+  for (int64_t t = warmup; t < int64_t(warmup) + steps; ++t) step(t);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double rate = static_cast<double>(steps) * envs / seconds;
   io.out << config << ": cpu, " << envs << " envs x " << steps << " steps on " << threads

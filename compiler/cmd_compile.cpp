@@ -1,5 +1,7 @@
 // kagec compile CONFIG -o DIR: Spec -> lowered params -> generated source -> fatbin (nvcc) and host
 // library (c++), with params.bin, assets.bin, spec.json and a manifest naming every file's SHA-256.
+// Everything is built in a staging directory beside DIR that replaces DIR only when the compile
+// succeeded, so DIR never mixes the files of two compiles.
 #include <filesystem>
 #include <fstream>
 #include <ostream>
@@ -8,6 +10,8 @@
 #include "compiler/build.h"
 #include "compiler/cli_common.h"
 #include "compiler/codegen.h"
+#include "compiler/compiled_dir.h"
+#include "compiler/file_out.h"
 #include "compiler/lower.h"
 #include "runtime/host/sha256.h"
 #include "runtime/host/specialized_assets.h"
@@ -17,12 +21,6 @@ namespace kage {
 namespace fs = std::filesystem;
 
 namespace {
-
-bool write_file(const fs::path& path, std::string_view bytes) {
-  std::ofstream f(path, std::ios::binary);
-  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return static_cast<bool>(f);
-}
 
 std::string read_file(const fs::path& path) {
   std::ifstream f(path, std::ios::binary);
@@ -74,12 +72,40 @@ int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
   }
   GeneratedSource gen = generate_source({spec->sha256(), lowered.config->latent, lowered.config->visual});
 
-  if (!source_name.empty()) gen.file_name = source_name;
-  const fs::path dir(out_dir);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  bool written = write_file(dir / gen.file_name, gen.text) && write_file(dir / "params.bin", params_blob(*lowered.config)) &&
-                 write_file(dir / "spec.json", spec->canonical_text());
+  if (!source_name.empty()) {
+    if (const auto problem = source_name_problem(source_name)) {
+      io.err << "kagec compile: " << *problem << '\n';
+      return kExitUsage;
+    }
+    gen.file_name = source_name;
+  }
+  if (const auto problem = output_dir_problem(out_dir)) {
+    io.err << "kagec compile: " << *problem << '\n';
+    return kExitUsage;
+  }
+  std::string error;
+  const std::optional<fs::path> staging = make_staging_dir(out_dir, &error);
+  if (!staging) {
+    io.err << "kagec compile: " << error << '\n';
+    return kExitErrors;
+  }
+  const fs::path& dir = *staging;
+  // Removes the staging directory on every early return; disarmed once it has been published.
+  struct Cleanup {
+    fs::path path;
+    ~Cleanup() {
+      std::error_code ec;
+      if (!path.empty()) fs::remove_all(path, ec);
+    }
+  } cleanup{dir};
+  auto write = [&](const std::string& name, const std::string& bytes) {
+    if (write_file((dir / name).string(), bytes, &error)) return true;
+    io.err << "kagec compile: " << error << '\n';
+    return false;
+  };
+  if (!write(gen.file_name, gen.text) || !write("params.bin", params_blob(*lowered.config)) ||
+      !write("spec.json", spec->canonical_text()))
+    return kExitErrors;
   std::vector<std::string> files = {gen.file_name, "params.bin", "spec.json"};
   if (!no_build) {
     AssetPackResult assets = load_asset_pack(lowered.config->assets);
@@ -88,7 +114,7 @@ int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
       return kExitErrors;
     }
     for (const std::string& w : assets.warnings) io.err << "kagec compile: warning: " << w << '\n';
-    written = written && write_file(dir / "assets.bin", serialize_asset_pack(*assets.pack));
+    if (!write("assets.bin", serialize_asset_pack(*assets.pack))) return kExitErrors;
     files.push_back("assets.bin");
   }
 
@@ -148,15 +174,20 @@ int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
       {"builds", builds},
       {"files", file_list},
   };
-  written = written && write_file(dir / "manifest.json", json_file_text(manifest));
-  if (!written) {
-    io.err << "kagec compile: cannot write under '" << dir.string() << "'\n";
-    return kExitErrors;
-  }
   bool failed = false;
   for (const auto& [name, b] : builds.items()) failed |= b.at("status") == "failed";
-  io.out << (dir / gen.file_name).string() << '\n';
-  return failed ? kExitErrors : kExitOk;
+  if (failed) {
+    io.err << "kagec compile: a build failed; '" << out_dir << "' is left as it was\n";
+    return kExitErrors;
+  }
+  if (!write(kManifestFile, json_file_text(manifest))) return kExitErrors;
+  if (!publish_staging_dir(dir, out_dir, &error)) {
+    io.err << "kagec compile: " << error << '\n';
+    return kExitErrors;
+  }
+  cleanup.path.clear();
+  io.out << (fs::path(out_dir) / gen.file_name).string() << '\n';
+  return kExitOk;
 }
 
 }  // namespace kage

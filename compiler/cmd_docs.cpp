@@ -19,6 +19,11 @@ std::string cell(std::string s) {
 std::string range_text(const KeySchema& k) {
   std::ostringstream s;
   const ValueRule& r = k.items && !k.value.minimum && !k.value.maximum ? *k.items : k.value;
+  if (r.names && r.names->id == k.path) {  // the key's own short list: spelt out
+    std::string names = "one of ";
+    for (size_t i = 0; i < r.names->names.size(); ++i) names += (i ? ", " : "") + r.names->names[i];
+    return names;
+  }
   if (r.names) return r.names->title + " names";
   if (r.minimum && r.maximum) s << "[" << *r.minimum << ", " << *r.maximum << "]";
   else if (r.minimum) s << ">= " << *r.minimum;

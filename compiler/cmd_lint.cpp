@@ -1,8 +1,8 @@
 // kagec lint, resolve, rules, schema.
-#include <fstream>
 #include <ostream>
 
 #include "compiler/cli_common.h"
+#include "compiler/file_out.h"
 #include "compiler/schema.h"
 
 namespace kage {
@@ -41,10 +41,9 @@ int cmd_resolve(const std::vector<std::string>& args, CommandIo& io) {
   if (output.empty()) {
     io.out << spec->canonical_text();
   } else {
-    std::ofstream f(output, std::ios::binary);
-    f << spec->canonical_text();
-    if (!f) {
-      io.err << "kagec resolve: cannot write '" << output << "'\n";
+    std::string error;
+    if (!write_file(output, spec->canonical_text(), &error)) {
+      io.err << "kagec resolve: " << error << '\n';
       return kExitErrors;
     }
   }

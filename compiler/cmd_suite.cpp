@@ -4,6 +4,7 @@
 #include <ostream>
 
 #include "compiler/cli_common.h"
+#include "compiler/file_out.h"
 #include "compiler/isolation.h"
 #include "compiler/suite.h"
 
@@ -64,20 +65,22 @@ int cmd_suite(const std::vector<std::string>& args, CommandIo& io) {
   const fs::path dir = out_dir.empty() ? fs::path("out") / suite->name : fs::path(out_dir);
   std::error_code ec;
   fs::create_directories(dir / "certificates", ec);
+  if (ec) {
+    io.err << "kagec suite: cannot create '" << (dir / "certificates").string() << "': " << ec.message() << '\n';
+    return kExitErrors;
+  }
   Json json = suite_report_json(*suite, report);
   size_t isolation_failures = 0;
   if (compile) isolation_failures = add_isolation_evidence(report, json, io.out);
-  std::ofstream f(dir / "report.json", std::ios::binary);
-  f << json_file_text(json);
+  std::string error;
+  bool written = write_file((dir / "report.json").string(), json_file_text(json), &error);
   for (const Json& pair : json.at("pairs")) {
-    std::string name = pair.at("pair").get<std::string>();
-    for (char& c : name)
-      if (c == '/' || c == ' ') c = '_';
-    std::ofstream cf(dir / "certificates" / (name + ".json"), std::ios::binary);
-    cf << json_file_text(pair);
+    if (!written) break;
+    written = write_file((dir / "certificates" / certificate_file_name(pair.at("pair").get<std::string>())).string(),
+                         json_file_text(pair), &error);
   }
-  if (!f || ec) {
-    io.err << "kagec suite: cannot write the report under '" << dir.string() << "'\n";
+  if (!written) {
+    io.err << "kagec suite: " << error << '\n';
     return kExitErrors;
   }
   io.out << "report: " << (dir / "report.json").string() << '\n';

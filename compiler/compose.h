@@ -18,6 +18,8 @@ namespace kage {
 
 /// The meta key naming a base config.
 inline constexpr const char* kExtendsKey = "extends";
+/// The most files an `extends` chain may hold (the file itself included).
+inline constexpr size_t kMaxExtendsDepth = 64;
 
 struct ComposedConfig {
   DocNode root;                 // merged mapping (without `extends`)

@@ -112,6 +112,24 @@ std::string location_prefix(const SourceManager& sm, Loc loc) {
   return sm.name(loc.file) + ":" + std::to_string(lc.line) + ":" + std::to_string(lc.col);
 }
 
+/// `text` with control characters as \xNN: a file name or value holding an escape sequence must not
+/// drive the terminal, nor a newline split a diagnostic.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      static const char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 void print_snippet(const SourceManager& sm, const Range& range, std::ostream& out) {
   if (!range.begin.valid()) return;
   const std::string_view line = sm.line_text(range.begin);
@@ -134,14 +152,15 @@ void print_text(const DiagEngine& engine, std::ostream& out, bool color) {
   const char* reset = color ? "\033[0m" : "";
   for (const Diagnostic& d : engine.sorted()) {
     const char* sev_color = !color ? "" : d.severity == Severity::Error ? "\033[1;31m" : "\033[1;35m";
-    out << bold << location_prefix(sm, d.range.begin) << ": " << reset << sev_color << severity_name(d.severity)
-        << ": " << reset << bold << d.message << " [" << rule_info(d.rule).id << "]" << reset << '\n';
+    out << bold << printable(location_prefix(sm, d.range.begin)) << ": " << reset << sev_color
+        << severity_name(d.severity) << ": " << reset << bold << printable(d.message) << " [" << rule_info(d.rule).id
+        << "]" << reset << '\n';
     print_snippet(sm, d.range, out);
     for (const FixIt& f : d.fixits)
-      if (f.range.begin.valid()) out << "fix-it: replace with '" << f.replacement << "'\n";
+      if (f.range.begin.valid()) out << "fix-it: replace with '" << printable(f.replacement) << "'\n";
     for (const DiagNote& n : d.notes) {
-      if (n.loc.valid()) out << location_prefix(sm, n.loc) << ": ";
-      out << "note: " << n.message << '\n';
+      if (n.loc.valid()) out << printable(location_prefix(sm, n.loc)) << ": ";
+      out << "note: " << printable(n.message) << '\n';
     }
   }
 }

@@ -21,6 +21,13 @@ struct EnvironmentOptions {
 
 class Environment;
 
+/// Bytes a CPU batch of this configuration holds (observations, states, layouts, render scratch).
+uint64_t batch_bytes_estimate(const LoweredConfig& config, int64_t num_envs, int64_t num_threads);
+/// The machine's physical memory in bytes (0 when unknown).
+uint64_t physical_memory_bytes();
+/// "1.5 GiB".
+std::string gib_text(uint64_t bytes);
+
 /// Result of Environment::open: `env`, or the diagnostics / loading errors as text in `error`.
 struct [[nodiscard]] EnvironmentResult {
   std::unique_ptr<Environment> env;

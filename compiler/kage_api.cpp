@@ -9,9 +9,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <sstream>
 
 #include "compiler/codegen.h"
+#include "compiler/compiled_dir.h"
 #include "compiler/lower.h"
 #include "compiler/resolve.h"
 #include "runtime/host/asset_pack.h"
@@ -278,7 +280,7 @@ std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const 
   const CUcontext ctx = cuda_primary_context(error);
   if (!ctx) return *kind = ErrorKind::kDevice, nullptr;
   std::optional<CudaModule> m;
-  if (!fatbin.empty() && fs::exists(fatbin)) {
+  if (!fatbin.empty()) {
     m = CudaModule::load_file(fatbin, error);
   } else {
     NvrtcOptions no;
@@ -310,9 +312,18 @@ std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::st
     *kind = ErrorKind::kFile;
     if (!text) return fail(error, "kage::open: no manifest.json in '" + path + "' (write one with kagec compile)"), nullptr;
     const Json manifest = Json::parse(*text, nullptr, false);
-    if (manifest.is_discarded() || manifest.value("kagec_manifest", 0) != 1)
+    if (manifest.is_discarded() || !manifest.is_object() || manifest.value("kagec_manifest", 0) != 1)
       return fail(error, "kage::open: '" + path + "/manifest.json' is not a kagec manifest"), nullptr;
-    if (o.backend == Backend::kCpu) return open_compiled_cpu(dir, manifest, o, error);
+    // Nothing is loaded from a directory whose files are not exactly the ones its compile wrote.
+    std::string problem;
+    const std::optional<std::set<std::string>> listed = verify_compiled_files(dir, manifest, &problem);
+    if (!listed) return fail(error, "kage::open: " + problem), nullptr;
+    if (o.backend == Backend::kCpu) {
+      if (!listed->count("kernels_host.so"))
+        return fail(error, "kage::open: '" + path + "' has no kernels_host.so (compile without --no-host/--no-build)"),
+               nullptr;
+      return open_compiled_cpu(dir, manifest, o, error);
+    }
     *kind = ErrorKind::kOther;
 #if defined(KAGE_API_HAVE_CUDA)
     const auto params = read_file(dir / "params.bin");
@@ -324,7 +335,8 @@ std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::st
     Loaded l{manifest.value("spec_sha256", ""), {}};
     std::memcpy(&l.config.latent, params->data(), sizeof(LatentParams));
     std::memcpy(&l.config.visual, params->data() + sizeof(LatentParams), sizeof(VisualParams));
-    return open_gpu(l, *source, (dir / "kernels.fatbin").string(), std::move(*pack), o, error, kind);
+    const std::string fatbin = listed->count("kernels.fatbin") ? (dir / "kernels.fatbin").string() : std::string();
+    return open_gpu(l, *source, fatbin, std::move(*pack), o, error, kind);
 #endif
   }
   std::optional<Loaded> l = load_yaml(path, o, error);

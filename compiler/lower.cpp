@@ -26,8 +26,15 @@ struct CapacityLimit {
   double hi;
 };
 
+// Observation sides and the world width: frames are indexed with 32-bit offsets (H * W * 3 per
+// environment) and the layout's mask holds one byte per world column.
+constexpr double kMaxImageSide = 4096;
+constexpr double kMaxWorldWidth = 1 << 20;
+
 const CapacityLimit kCapacityLimits[] = {
     {"positive", 1, kNoBound},
+    {"image_side", 1, kMaxImageSide},
+    {"world_width", 1, kMaxWorldWidth},
     {"non_negative", 0, kNoBound},
     {"segment_byte", 0, 255},
     {"npc_slots", 0, kMaxNpcs},
@@ -273,6 +280,21 @@ std::string LowerResult::error_text() const {
 
 std::vector<CapacityError> capacity_errors(const Spec& spec) {
   std::vector<CapacityError> out;
+  // Every integer is narrowed to int32 by the lowering, inert or not: one that does not fit would wrap.
+  for (const KeySchema& k : config_schema().keys()) {
+    if (k.ctype != "int" && k.ctype != "int?" && k.ctype != "int_list") continue;
+    const Json& v = spec.value(k.path);
+    for (const Json& x : v.is_array() ? v : Json::array({v})) {
+      if (!x.is_number_integer()) continue;
+      const bool fits = x.is_number_unsigned() ? x.get<uint64_t>() <= uint64_t(INT32_MAX)
+                                               : x.get<int64_t>() >= INT32_MIN && x.get<int64_t>() <= INT32_MAX;
+      if (fits) continue;
+      out.push_back(CapacityError{k.path, "is " + x.dump() + ", which does not fit the runtime's 32-bit integers (" +
+                                              std::to_string(INT32_MIN) + ".." + std::to_string(INT32_MAX) +
+                                              "); use a smaller value"});
+      break;
+    }
+  }
   for (const KeySchema& k : config_schema().keys()) {
     if (k.capacity_limit.empty() || spec.inert.count(k.path)) continue;
     const CapacityLimit& r = capacity_limit(k.capacity_limit);

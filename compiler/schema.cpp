@@ -105,10 +105,11 @@ class SchemaLoader {
     return it == out_.tables_.end() ? nullptr : &it->second;
   }
 
-  ValueRule value_rule(const Json& raw) const {
+  ValueRule value_rule(const Json& raw, const std::string& path) {
     ValueRule r;
     r.names = table_of(raw);
     const Json& node = deref(raw);
+    if (!r.names && node.contains("enum")) r.names = inline_table(path, node.at("enum"));
     if (node.contains("type")) {
       if (node.at("type").is_array())
         for (const Json& t : node.at("type")) r.types.insert(t.get<std::string>());
@@ -120,6 +121,16 @@ class SchemaLoader {
     if (node.contains("maximum")) r.maximum = node.at("maximum").get<double>();
     if (node.contains("exclusiveMinimum")) r.exclusive_minimum = node.at("exclusiveMinimum").get<double>();
     return r;
+  }
+
+  // A key's own enum (the names the original maps silently): a table named after the key.
+  const NameTable* inline_table(const std::string& path, const Json& names) {
+    NameTable t;
+    t.id = path;
+    t.title = "value";
+    for (const Json& n : names)
+      if (n.is_string()) t.names.push_back(n.get<std::string>());
+    return &(out_.tables_[path] = std::move(t));
   }
 
   void add_key(const std::string& section, const std::string& name, const Json& prop, SectionSchema& sec) {
@@ -138,18 +149,18 @@ class SchemaLoader {
       const Json& alts = prop.at("anyOf");
       for (const Json& alt : alts) {
         if (alt.value("type", "") == "array") {
-          k.items = value_rule(alt.at("items"));
+          k.items = value_rule(alt.at("items"), k.path);
           if (alt.contains("minItems")) k.min_items = alt.at("minItems").get<size_t>();
         } else {
-          k.value = value_rule(alt);
+          k.value = value_rule(alt, k.path);
         }
       }
       k.value.types.insert("array");
       k.string_as_list = true;
     } else {
       const Json& node = deref(prop);
-      k.value = value_rule(prop);
-      if (node.contains("items")) k.items = value_rule(node.at("items"));
+      k.value = value_rule(prop, k.path);
+      if (node.contains("items")) k.items = value_rule(node.at("items"), k.path);
       if (node.contains("minItems")) k.min_items = node.at("minItems").get<size_t>();
       if (node.contains("maxItems")) k.max_items = node.at("maxItems").get<size_t>();
       if (prop.contains("minItems")) k.min_items = prop.at("minItems").get<size_t>();

@@ -9,22 +9,58 @@
 #include <system_error>
 #include <filesystem>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 namespace kage {
 
 std::optional<std::string> DiskFileReader::read(const std::string& path, std::string* err) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    *err = "is a directory, not a file";
-    return std::nullopt;
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  // Opened without blocking, then checked: a FIFO, a device or /proc file is refused before any read
+  // could hang, run without end, or return nothing.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
     *err = std::strerror(errno);
     return std::nullopt;
   }
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  return buf.str();
+  struct stat st {};
+  std::optional<std::string> out;
+  if (::fstat(fd, &st) != 0) {
+    *err = std::strerror(errno);
+  } else if (S_ISDIR(st.st_mode)) {
+    *err = "is a directory, not a file";
+  } else if (!S_ISREG(st.st_mode)) {
+    *err = "is not a regular file (a FIFO, device or socket); give a config file";
+  } else if (static_cast<uint64_t>(st.st_size) > kMaxConfigBytes) {
+    *err = "is " + std::to_string(st.st_size) + " bytes; a config may be at most " +
+           std::to_string(kMaxConfigBytes >> 20) + " MiB";
+  } else {
+    // One byte past the stated size must read as the end: /proc files state size 0 and then produce
+    // data or fail (/proc/self/mem), and a file that grows is being written.
+    std::string text(static_cast<size_t>(st.st_size) + 1, '\0');
+    size_t done = 0;
+    bool failed = false;
+    while (done < text.size()) {
+      const ssize_t n = ::read(fd, text.data() + done, text.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        *err = std::string("read failed: ") + std::strerror(errno);
+        failed = true;
+        break;
+      }
+      if (n == 0) break;
+      done += static_cast<size_t>(n);
+    }
+    if (!failed && done == static_cast<size_t>(st.st_size)) {
+      text.resize(done);
+      out = std::move(text);
+    } else if (!failed) {
+      *err = "does not hold the " + std::to_string(st.st_size) +
+             " bytes its size states (a special or changing file); give a config file";
+    }
+  }
+  ::close(fd);
+  return out;
 }
 
 FileId SourceManager::add(std::string name, std::string text) {

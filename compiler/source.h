@@ -42,7 +42,10 @@ class FileReader {
   virtual std::optional<std::string> read(const std::string& path, std::string* err) = 0;
 };
 
-/// The real file system.
+/// The largest config file read (configs are a few KB; this bounds memory on hostile input).
+inline constexpr uint64_t kMaxConfigBytes = uint64_t(16) << 20;
+
+/// The real file system: regular files only, at most kMaxConfigBytes, every read error an error.
 class DiskFileReader final : public FileReader {
  public:
   std::optional<std::string> read(const std::string& path, std::string* err) override;

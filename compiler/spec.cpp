@@ -73,7 +73,34 @@ Json Spec::to_json() const {
   return j;
 }
 
-std::string Spec::sha256() const { return sha256_hex(to_json().dump()); }
+std::string Spec::sha256() const {
+  // Paths tell where the command ran, not what the configuration is: the hash leaves every asset
+  // path out and keeps the assets' content hashes and sizes.
+  Json j = to_json();
+  Json& config = j["config"];
+  auto blank = [](Json& v) {
+    if (v.is_string()) v = "";
+    if (v.is_array())
+      for (Json& item : v)
+        if (item.is_string()) item = "";
+  };
+  for (const KeySchema& k : config_schema().keys()) {
+    if (k.asset_kind.empty()) continue;
+    if (k.section.empty()) {
+      if (config.contains(k.name)) blank(config[k.name]);
+    } else if (config.contains(k.section) && config[k.section].is_object() && config[k.section].contains(k.name)) {
+      blank(config[k.section][k.name]);
+    }
+  }
+  Json& assets = j["assets"];
+  for (Json& f : assets["backgrounds"]) f.erase("file");
+  for (const char* group : {"agent_skins", "npc_types", "sticky_types"})
+    for (Json& set : assets[group]) {
+      set.erase("dir");
+      for (Json& f : set["frames"]) f.erase("file");
+    }
+  return sha256_hex(j.dump());
+}
 
 std::string Spec::canonical_text() const {
   Json j = to_json();

@@ -3,7 +3,7 @@
 // Every parameter explicit (with the original loader's absent-key rules
 // applied), inert settings marked, assets located and content-hashed.
 // Printed as canonical JSON (sorted keys, shortest round-trip numbers), whose
-// SHA-256 identifies the configuration.
+// SHA-256 (paths left out, asset content in) identifies the configuration.
 #pragma once
 
 #include <set>
@@ -45,7 +45,8 @@ struct Spec {
   Json to_json() const;
   /// The canonical text: to_json() with the hash added, pretty-printed, sorted.
   std::string canonical_text() const;
-  /// SHA-256 of the compact canonical form of to_json().
+  /// SHA-256 of the compact canonical form of to_json() without its asset paths (the assets count
+  /// by content), so that it does not depend on the working directory or the file's location.
   std::string sha256() const;
   /// Only the latent keys (physics, layout geometry, reward, screen).
   Json latent_values(const Schema& schema) const;

@@ -7,7 +7,8 @@
 
 namespace kage {
 
-/// Edit distance (insert, delete, substitute), optionally ignoring case.
+/// Edit distance (insert, delete, substitute, transpose two adjacent characters: each one edit),
+/// optionally ignoring case.
 size_t edit_distance(const std::string& a, const std::string& b, bool ignore_case);
 
 /// The unique best candidate within min(3, max(1, len/3)) edits, case-insensitive

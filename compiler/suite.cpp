@@ -1,6 +1,7 @@
 // Suite manifests: loading, running, reporting.
 #include "compiler/suite.h"
 
+#include <cctype>
 #include <iomanip>
 #include <map>
 #include <ostream>
@@ -49,10 +50,38 @@ class SuiteLoader {
     }
     if (suite.pairs.empty() && !diags_.has_errors())
       diags_.report(Rule::SuiteInvalid, doc->range, "the suite has no pairs; add 'pairs' or 'sweeps'");
+    check_names(suite, *doc);
     return suite;
   }
 
  private:
+  // The suite's name names its output directory and each pair's name its certificate file: a name
+  // that leaves the directory, or two pairs sharing a file, would overwrite other files.
+  void check_names(const Suite& suite, const DocNode& doc) {
+    const DocEntry* name = doc.find("suite");
+    if (name && !suite.name.empty() && !plain_name(suite.name))
+      diags_.report(Rule::SuiteInvalid, name->value.range,
+                    "suite name '" + suite.name +
+                        "' names the output directory out/<suite>: use letters, digits, '_', '-' and '.' only, "
+                        "not starting with '.'");
+    std::map<std::string, const SuitePair*> files;
+    for (const SuitePair& p : suite.pairs) {
+      const auto [it, fresh] = files.emplace(certificate_file_name(p.name), &p);
+      if (fresh) continue;
+      const LineCol at = sources_.line_col(it->second->range.begin);
+      diags_.report(Rule::SuiteInvalid, p.range,
+                    "pair '" + p.name + "' has the certificate file of pair '" + it->second->name + "' (line " +
+                        std::to_string(at.line) + "): " + it->first + "; give every pair its own name");
+    }
+  }
+
+  static bool plain_name(const std::string& name) {
+    if (name.empty() || name[0] == '.') return false;
+    for (char c : name)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.') return false;
+    return true;
+  }
+
   template <class F>
   void for_each_item(const DocEntry& e, F f) {
     if (!e.value.is_seq()) {
@@ -180,6 +209,14 @@ class SuiteLoader {
 };
 
 }  // namespace
+
+std::string certificate_file_name(const std::string& pair_name) {
+  std::string name = pair_name;
+  for (char& c : name)
+    if (c == '/' || c == ' ' || c == '\\' || static_cast<unsigned char>(c) < 0x20) c = '_';
+  if (name.empty() || name[0] == '.') name.insert(0, "_");
+  return name + ".json";
+}
 
 std::optional<Suite> load_suite(const std::string& path, SourceManager& sources, FileReader& reader,
                                 DiagEngine& diags) {

@@ -40,6 +40,9 @@ struct Suite {
   std::vector<SuitePair> pairs;  // sweeps expanded into pairs
 };
 
+/// The file name of a pair's certificate under DIR/certificates/ ('/' and spaces become '_').
+std::string certificate_file_name(const std::string& pair_name);
+
 /// Reads a manifest; structural errors go to diags.
 std::optional<Suite> load_suite(const std::string& path, SourceManager& sources, FileReader& reader,
                                 DiagEngine& diags);

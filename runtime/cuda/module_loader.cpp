@@ -83,7 +83,15 @@ std::optional<std::string> cache_lookup(const fs::path& file, const std::string&
   return text.substr(header.size());
 }
 
-/// Compiles `source` to a cubin for sm_<major><minor>.
+}  // namespace
+
+std::vector<std::string> nvrtc_option_list(const std::string& arch, const NvrtcOptions& options) {
+  std::vector<std::string> opts = {"--gpu-architecture=" + arch, "-std=c++20", "--fmad=false",
+                                   "-I" + options.include_dir};
+  opts.insert(opts.end(), options.extra_options.begin(), options.extra_options.end());
+  return opts;
+}
+
 std::optional<std::string> nvrtc_compile(const std::string& source, const std::string& name,
                                          const std::vector<std::string>& options, std::string* error) {
   nvrtcProgram prog;
@@ -122,8 +130,6 @@ std::optional<std::string> nvrtc_compile(const std::string& source, const std::s
   }
   return cubin;
 }
-
-}  // namespace
 
 std::string cu_error_text(CUresult r, const char* what) {
   if (r == CUDA_SUCCESS) return {};
@@ -186,8 +192,8 @@ std::optional<CudaModule> CudaModule::load_file(const std::string& path, std::st
   return m;
 }
 
-std::optional<CudaModule> CudaModule::compile(const std::string& source, const std::string& name,
-                                              const NvrtcOptions& options, std::string* error, bool* cache_hit) {
+std::optional<std::string> cubin_for(const std::string& source, const std::string& name, const NvrtcOptions& options,
+                                     std::string* error, bool* cache_hit, bool read_cache) {
   if (cache_hit) *cache_hit = false;
   if (!cuda_primary_context(error)) return std::nullopt;
   CUdevice dev;
@@ -200,9 +206,7 @@ std::optional<CudaModule> CudaModule::compile(const std::string& source, const s
     return std::nullopt;
   }
   const std::string arch = "sm_" + std::to_string(major) + std::to_string(minor);
-  std::vector<std::string> opts = {"--gpu-architecture=" + arch, "-std=c++20", "--fmad=false",
-                                   "-I" + options.include_dir};
-  opts.insert(opts.end(), options.extra_options.begin(), options.extra_options.end());
+  const std::vector<std::string> opts = nvrtc_option_list(arch, options);
 
   int nv_major = 0, nv_minor = 0;
   const nvrtcResult vr = nvrtcVersion(&nv_major, &nv_minor);
@@ -226,13 +230,10 @@ std::optional<CudaModule> CudaModule::compile(const std::string& source, const s
 
   const std::string dir = kernel_cache_dir();
   const fs::path file = dir.empty() ? fs::path() : fs::path(dir) / (key + ".cubin");
-  if (!dir.empty()) {
+  if (!dir.empty() && read_cache) {
     if (std::optional<std::string> cubin = cache_lookup(file, key)) {
-      std::optional<CudaModule> m = load_image(cubin->data(), error);
-      if (m) {
-        if (cache_hit) *cache_hit = true;
-        return m;
-      }
+      if (cache_hit) *cache_hit = true;
+      return cubin;
     }
   }
   std::optional<std::string> cubin = nvrtc_compile(source, name, opts, error);
@@ -243,7 +244,23 @@ std::optional<CudaModule> CudaModule::compile(const std::string& source, const s
     // A cache that cannot be written only costs the next load a compilation.
     if (!ec) write_atomically(file, std::string(kCacheTag) + " " + key + "\n" + *cubin);
   }
-  return load_image(cubin->data(), error);
+  return cubin;
+}
+
+std::optional<CudaModule> CudaModule::compile(const std::string& source, const std::string& name,
+                                              const NvrtcOptions& options, std::string* error, bool* cache_hit) {
+  bool hit = false;
+  std::optional<std::string> cubin = cubin_for(source, name, options, error, &hit);
+  if (!cubin) return std::nullopt;
+  std::optional<CudaModule> m = load_image(cubin->data(), error);
+  if (!m && hit) {  // a cached cubin that does not load is compiled again (and replaced)
+    hit = false;
+    cubin = cubin_for(source, name, options, error, nullptr, false);
+    if (!cubin) return std::nullopt;
+    m = load_image(cubin->data(), error);
+  }
+  if (cache_hit) *cache_hit = hit;
+  return m;
 }
 
 CudaModule::CudaModule(CudaModule&& other) noexcept : module_(other.module_) { other.module_ = nullptr; }

@@ -28,6 +28,21 @@ struct NvrtcOptions {
   std::vector<std::string> extra_options;
 };
 
+/// The NVRTC options of a run-time compilation for `arch` (e.g. "sm_90"): the one list that the
+/// loader uses and that tests/cuda/nvrtc_check.cpp compiles with.
+std::vector<std::string> nvrtc_option_list(const std::string& arch, const NvrtcOptions& options);
+
+/// Compiles `source` with NVRTC to a cubin (no driver, no GPU needed); null with the log in `error`.
+std::optional<std::string> nvrtc_compile(const std::string& source, const std::string& name,
+                                         const std::vector<std::string>& options, std::string* error);
+
+/// The cubin of `source` for the current device: from the cache, or compiled with NVRTC and stored
+/// there. Thread-safe (each call makes the primary context current on its thread), so several
+/// configs can compile at once. `cache_hit`, if given, tells which happened; `read_cache` false
+/// compiles even when the cache holds the cubin.
+std::optional<std::string> cubin_for(const std::string& source, const std::string& name, const NvrtcOptions& options,
+                                     std::string* error, bool* cache_hit = nullptr, bool read_cache = true);
+
 /// Where the cubin cache lives: $KAGE_CACHE_DIR, else ~/.cache/kagec; empty when KAGE_CACHE=off.
 std::string kernel_cache_dir();
 

@@ -28,14 +28,24 @@ bool is_dir(const std::string& dir) {
   return fs::is_directory(dir, ec);
 }
 
+bool too_many(const std::string& dir, int visited, std::string* error) {
+  if (visited <= kMaxScanEntries) return false;
+  if (error)
+    *error = "'" + dir + "' holds more than " + std::to_string(kMaxScanEntries) +
+             " entries; point at a folder of assets";
+  return true;
+}
+
 }  // namespace
 
-std::optional<std::vector<std::string>> scan_background_dir(const std::string& dir) {
+std::optional<std::vector<std::string>> scan_background_dir(const std::string& dir, std::string* error) {
   if (!is_dir(dir)) return std::nullopt;
   static const char* const kPatterns[] = {".jpg", ".jpeg", ".png", ".bmp"};
   std::vector<std::string> out;
   std::error_code ec;
+  int visited = 0;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (too_many(dir, ++visited, error)) return std::nullopt;
     const std::string name = entry.path().filename().string();
     for (const char* suffix : kPatterns) {
       if (ends_with(name, suffix)) {
@@ -48,11 +58,13 @@ std::optional<std::vector<std::string>> scan_background_dir(const std::string& d
   return out;
 }
 
-std::optional<std::vector<std::string>> scan_skin_parent(const std::string& dir) {
+std::optional<std::vector<std::string>> scan_skin_parent(const std::string& dir, std::string* error) {
   if (!is_dir(dir)) return std::nullopt;
   std::vector<std::string> out;
   std::error_code ec;
+  int visited = 0;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (too_many(dir, ++visited, error)) return std::nullopt;
     std::error_code ec2;
     if (entry.is_directory(ec2)) out.push_back(join(dir, entry.path().filename().string()));
   }
@@ -60,12 +72,20 @@ std::optional<std::vector<std::string>> scan_skin_parent(const std::string& dir)
   return out;
 }
 
-std::vector<std::string> scan_skin_frames(const std::string& dir) {
+std::vector<std::string> scan_skin_frames(const std::string& dir, std::string* error) {
   std::vector<std::string> out;
   if (!is_dir(dir)) return out;
   std::error_code ec;
+  int visited = 0;
   for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
        it.increment(ec)) {
+    if (too_many(dir, ++visited, error)) return {};
+    if (it.depth() >= kMaxScanDepth) {
+      if (error)
+        *error = "'" + dir + "' is nested deeper than " + std::to_string(kMaxScanDepth) +
+                 " levels; point at a folder of assets";
+      return {};
+    }
     const std::string name = it->path().filename().string();
     if (!ends_with(name, ".png")) continue;
     std::error_code ec2;

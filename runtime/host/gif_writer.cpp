@@ -121,26 +121,12 @@ void gif_palette_color(uint8_t index, uint8_t rgb[3]) {
   rgb[2] = value_of(index % kLevelsB, kLevelsB);
 }
 
-std::vector<uint8_t> encode_gif(const std::vector<Image>& frames, int delay_cs, std::string* error) {
-  std::vector<uint8_t> out;
-  auto set_error = [&](const std::string& e) {
-    if (error) *error = e;
-    return std::vector<uint8_t>{};
-  };
-  if (frames.empty()) return set_error("no frames to encode");
-  const int w = frames[0].width, h = frames[0].height;
-  if (w <= 0 || h <= 0 || w > 65535 || h > 65535) return set_error("invalid frame size");
-  for (size_t i = 0; i < frames.size(); ++i) {
-    const Image& f = frames[i];
-    if (f.width != w || f.height != h || (f.channels != 3 && f.channels != 4) ||
-        f.pixels.size() != size_t(w) * h * f.channels) {
-      return set_error(fmt::format("frame {} differs in size or is not RGB/RGBA", i));
-    }
-  }
-  if (delay_cs < 0) delay_cs = 0;
-  if (delay_cs > 65535) delay_cs = 65535;
+namespace {
 
-  out.reserve(1024 + frames.size() * (size_t(w) * h + 64));
+int clamp_delay(int delay_cs) { return delay_cs < 0 ? 0 : delay_cs > 65535 ? 65535 : delay_cs; }
+
+// Logical screen, global colour table and the looping extension.
+void put_header(std::vector<uint8_t>& out, int w, int h) {
   for (char c : std::string("GIF89a")) out.push_back(uint8_t(c));
   put16(out, w);
   put16(out, h);
@@ -156,27 +142,53 @@ std::vector<uint8_t> encode_gif(const std::vector<Image>& frames, int delay_cs, 
   const uint8_t kLoop[] = {0x21, 0xFF, 0x0B, 'N', 'E', 'T', 'S', 'C', 'A', 'P', 'E',
                            '2',  '.',  '0',  0x03, 0x01, 0x00, 0x00, 0x00};
   out.insert(out.end(), kLoop, kLoop + sizeof(kLoop));
+}
 
-  std::vector<uint8_t> indices(size_t(w) * h);
-  for (const Image& f : frames) {
-    // Graphic control extension: no transparency, dispose "do not dispose".
-    out.insert(out.end(), {0x21, 0xF9, 0x04, 0x04});
-    put16(out, delay_cs);
-    out.push_back(0);
-    out.push_back(0);
-    // Image descriptor: full frame, no local colour table, not interlaced.
-    out.push_back(0x2C);
-    put16(out, 0);
-    put16(out, 0);
-    put16(out, w);
-    put16(out, h);
-    out.push_back(0);
-    for (size_t p = 0; p < indices.size(); ++p) {
-      const uint8_t* px = f.pixels.data() + p * f.channels;
-      indices[p] = gif_palette_index(px[0], px[1], px[2]);
-    }
-    LzwEncoder(out).encode(indices);
+// One frame: graphic control extension, image descriptor, LZW data.
+void put_frame(std::vector<uint8_t>& out, const Image& f, int delay_cs) {
+  // Graphic control extension: no transparency, dispose "do not dispose".
+  out.insert(out.end(), {0x21, 0xF9, 0x04, 0x04});
+  put16(out, delay_cs);
+  out.push_back(0);
+  out.push_back(0);
+  // Image descriptor: full frame, no local colour table, not interlaced.
+  out.push_back(0x2C);
+  put16(out, 0);
+  put16(out, 0);
+  put16(out, f.width);
+  put16(out, f.height);
+  out.push_back(0);
+  std::vector<uint8_t> indices(size_t(f.width) * f.height);
+  for (size_t p = 0; p < indices.size(); ++p) {
+    const uint8_t* px = f.pixels.data() + p * f.channels;
+    indices[p] = gif_palette_index(px[0], px[1], px[2]);
   }
+  LzwEncoder(out).encode(indices);
+}
+
+bool valid_size(int w, int h) { return w > 0 && h > 0 && w <= 65535 && h <= 65535; }
+
+bool matches(const Image& f, int w, int h) {
+  return f.width == w && f.height == h && (f.channels == 3 || f.channels == 4) &&
+         f.pixels.size() == size_t(w) * h * f.channels;
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode_gif(const std::vector<Image>& frames, int delay_cs, std::string* error) {
+  std::vector<uint8_t> out;
+  auto set_error = [&](const std::string& e) {
+    if (error) *error = e;
+    return std::vector<uint8_t>{};
+  };
+  if (frames.empty()) return set_error("no frames to encode");
+  const int w = frames[0].width, h = frames[0].height;
+  if (!valid_size(w, h)) return set_error("invalid frame size");
+  for (size_t i = 0; i < frames.size(); ++i)
+    if (!matches(frames[i], w, h)) return set_error(fmt::format("frame {} differs in size or is not RGB/RGBA", i));
+  out.reserve(1024 + frames.size() * (size_t(w) * h + 64));
+  put_header(out, w, h);
+  for (const Image& f : frames) put_frame(out, f, clamp_delay(delay_cs));
   out.push_back(0x3B);  // trailer
   return out;
 }
@@ -189,6 +201,47 @@ IoStatus write_gif(const std::string& path, const std::vector<Image>& frames, in
   if (!f) return {fmt::format("{}: cannot open for writing", path)};
   const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
   if (std::fclose(f) != 0 || !ok) return {fmt::format("{}: write failed", path)};
+  return {};
+}
+
+GifStream::~GifStream() {
+  if (file_) std::fclose(file_);
+}
+
+IoStatus GifStream::open(const std::string& path, int width, int height, int delay_cs) {
+  if (!valid_size(width, height)) return {fmt::format("{}: invalid frame size", path)};
+  path_ = path;
+  width_ = width;
+  height_ = height;
+  delay_cs_ = clamp_delay(delay_cs);
+  file_ = std::fopen(path.c_str(), "wb");
+  if (!file_) return {fmt::format("{}: cannot open for writing", path)};
+  std::vector<uint8_t> header;
+  put_header(header, width, height);
+  return put(header);
+}
+
+IoStatus GifStream::add(const Image& frame) {
+  if (!file_) return {fmt::format("{}: not open", path_)};
+  if (!matches(frame, width_, height_)) return {fmt::format("{}: frame differs in size or is not RGB/RGBA", path_)};
+  std::vector<uint8_t> bytes;
+  put_frame(bytes, frame, delay_cs_);
+  return put(bytes);
+}
+
+IoStatus GifStream::finish() {
+  if (!file_) return {fmt::format("{}: not open", path_)};
+  const IoStatus st = put({0x3B});
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!st.ok()) return st;
+  if (!closed) return {fmt::format("{}: write failed", path_)};
+  return {};
+}
+
+IoStatus GifStream::put(const std::vector<uint8_t>& bytes) {
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size())
+    return {fmt::format("{}: write failed", path_)};
   return {};
 }
 

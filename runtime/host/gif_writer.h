@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -24,5 +25,27 @@ std::vector<uint8_t> encode_gif(const std::vector<Image>& frames, int delay_cs, 
 
 /// encode_gif, then writes the bytes to `path`.
 IoStatus write_gif(const std::string& path, const std::vector<Image>& frames, int delay_cs);
+
+/// The same GIF written one frame at a time, so that a long run never holds its frames in memory.
+/// Every write and the close are checked.
+class GifStream {
+ public:
+  GifStream() = default;
+  GifStream(const GifStream&) = delete;
+  GifStream& operator=(const GifStream&) = delete;
+  ~GifStream();
+  /// Creates `path` and writes the header for frames of width x height.
+  IoStatus open(const std::string& path, int width, int height, int delay_cs);
+  /// Appends one frame (3 or 4 channels, the size given to open).
+  IoStatus add(const Image& frame);
+  /// Writes the trailer and closes the file.
+  IoStatus finish();
+
+ private:
+  IoStatus put(const std::vector<uint8_t>& bytes);
+  std::string path_;
+  int width_ = 0, height_ = 0, delay_cs_ = 0;
+  std::FILE* file_ = nullptr;
+};
 
 }  // namespace kage

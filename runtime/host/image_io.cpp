@@ -75,6 +75,11 @@ ImageResult decode_image(const uint8_t* data, size_t size, int channels, const s
   }
   if (size > size_t(INT32_MAX)) return fail(ImageError::kUnsupported, name, "file too large");
   int w = 0, h = 0, n = 0;
+  if (stbi_info_from_memory(data, int(size), &w, &h, &n) && int64_t(w) * int64_t(h) > kMaxImagePixels) {
+    return fail(ImageError::kTooLarge, name,
+                fmt::format("image too large: {}x{} pixels, more than {} ({}x{}); use a smaller image", w, h,
+                            kMaxImagePixels, 4096, 4096));
+  }
   stbi_uc* px = stbi_load_from_memory(data, int(size), &w, &h, &n, channels);
   if (px == nullptr) {
     const char* why = stbi_failure_reason();
@@ -110,16 +115,36 @@ ImageResult load_image(const std::string& path, int channels) {
   return decode_image(bytes.data(), bytes.size(), channels, path);
 }
 
+namespace {
+
+// stb's file writers ignore write and close errors: encode into memory, then write checked.
+void append_bytes(void* context, void* data, int size) {
+  auto* out = static_cast<std::string*>(context);
+  out->append(static_cast<const char*>(data), static_cast<size_t>(size));
+}
+
+IoStatus write_bytes(const std::string& path, const std::string& bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) return {fmt::format("{}: cannot open for writing ({})", path, std::strerror(errno))};
+  const bool wrote = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  const bool closed = std::fclose(f) == 0;
+  if (!wrote || !closed) return {fmt::format("{}: write failed ({})", path, std::strerror(errno))};
+  return {};
+}
+
+}  // namespace
+
 IoStatus write_png(const std::string& path, const Image& image) {
   if (image.width <= 0 || image.height <= 0 || image.channels < 1 || image.channels > 4 ||
       image.pixels.size() != size_t(image.width) * image.height * image.channels) {
     return {fmt::format("{}: invalid image for PNG output", path)};
   }
-  if (!stbi_write_png(path.c_str(), image.width, image.height, image.channels, image.pixels.data(),
-                      image.width * image.channels)) {
-    return {fmt::format("{}: cannot write PNG", path)};
+  std::string bytes;
+  if (!stbi_write_png_to_func(append_bytes, &bytes, image.width, image.height, image.channels, image.pixels.data(),
+                              image.width * image.channels)) {
+    return {fmt::format("{}: cannot encode PNG", path)};
   }
-  return {};
+  return write_bytes(path, bytes);
 }
 
 IoStatus write_jpeg(const std::string& path, const Image& image, int quality) {
@@ -127,10 +152,11 @@ IoStatus write_jpeg(const std::string& path, const Image& image, int quality) {
       image.pixels.size() != size_t(image.width) * image.height * 3) {
     return {fmt::format("{}: invalid image for JPEG output (RGB required)", path)};
   }
-  if (!stbi_write_jpg(path.c_str(), image.width, image.height, 3, image.pixels.data(), quality)) {
-    return {fmt::format("{}: cannot write JPEG", path)};
+  std::string bytes;
+  if (!stbi_write_jpg_to_func(append_bytes, &bytes, image.width, image.height, 3, image.pixels.data(), quality)) {
+    return {fmt::format("{}: cannot encode JPEG", path)};
   }
-  return {};
+  return write_bytes(path, bytes);
 }
 
 // ---- Pillow Lanczos (libImaging/Resample.c, 8 bits per channel) ----

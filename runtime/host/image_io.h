@@ -31,6 +31,7 @@ enum class ImageError {
   kEmpty,        ///< a zero-byte file, or a decoded size of zero
   kUnsupported,  ///< not a PNG, JPEG, BMP or GIF signature
   kCorrupt,      ///< right signature, but decoding failed or the data is truncated
+  kTooLarge,     ///< decodes to more than kMaxImagePixels pixels
   kWriteFailed,  ///< an output file could not be written
 };
 
@@ -48,6 +49,10 @@ struct [[nodiscard]] IoStatus {
   std::string error;
   bool ok() const { return error.empty(); }
 };
+
+/// The most pixels an image may decode to (4096 x 4096): a small file can claim a huge size, and
+/// decoding it would take seconds and gigabytes. Checked from the header, before decoding.
+inline constexpr int64_t kMaxImagePixels = int64_t(4096) * 4096;
 
 /// Loads `path` and converts it to `channels` (3 = RGB, 4 = RGBA) like Pillow's
 /// `convert`: grey is replicated, alpha is dropped for RGB and set to 255 when

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "compiler/codegen.h"
 #include "compiler/isolation.h"
@@ -58,7 +59,57 @@ std::string read(const std::string& path) {
   return s.str();
 }
 
+/// The hex words of the initializer that follows `marker` in a generated source, decoded as T.
+template <class T>
+std::optional<T> decode_words(const std::string& text, const std::string& marker) {
+  size_t at = text.find(marker);
+  if (at == std::string::npos) return std::nullopt;
+  at = text.find("Words{{", at);
+  const size_t end = text.find("}}", at);
+  if (at == std::string::npos || end == std::string::npos) return std::nullopt;
+  std::vector<uint32_t> words;
+  std::istringstream in(text.substr(at + 7, end - at - 7));
+  std::string token;
+  while (in >> token) words.push_back(static_cast<uint32_t>(std::stoul(token.substr(0, token.find('u')), nullptr, 16)));
+  if (words.size() * 4 != sizeof(T)) return std::nullopt;
+  T out;
+  std::memcpy(&out, words.data(), sizeof out);
+  return out;
+}
+
 }  // namespace
+
+TEST_CASE("the committed golden holds the values of simplest.yaml, by name", "[codegen][golden]") {
+  // Written by hand from configs/default.yaml and configs/kage_bench/bases/shape_black.yaml (which
+  // simplest.yaml extends), so the golden's words are checked against the config and not against the
+  // generator that wrote them.
+  const std::string golden = read(kRoot + "tests/codegen/simplest.expected.cu");
+  const auto latent = decode_words<kage::LatentParams>(golden, "LatentParams latent()");
+  const auto visual = decode_words<kage::VisualParams>(golden, "VisualParams visual()");
+  REQUIRE(latent);
+  REQUIRE(visual);
+  CHECK(latent->screen_h == 128);                   // H: 128
+  CHECK(latent->screen_w == 128);                   // W: 128
+  CHECK(latent->char_width == 16);                  // character.width: 16
+  CHECK(latent->length == 2048);                    // layout.length: 2048
+  CHECK(latent->gravity == 0.75f);                  // physics.gravity: 0.75
+  CHECK(latent->jump_velocity == -7.5f);            // physics.jump_force: -7.5
+  CHECK(latent->max_speed_x == 1.0f);               // physics.move_speed: 1
+  CHECK(latent->episode_length == 500);             // episode_length: 500
+  CHECK(latent->dist_to_success == 490.0f);         // dist_to_success: 490
+  CHECK(visual->H == 128);
+  CHECK(visual->W == 128);
+  CHECK(visual->bg_mode == kage::BackgroundMode::kBlack);  // background.mode: "black"
+  CHECK_FALSE(visual->use_sprites);                         // character.use_sprites: false
+  CHECK(visual->use_shape);                                 // character.use_shape: true
+  REQUIRE(visual->shape_color_count == 1);                  // character.shape_colors: ["teal"]
+  CHECK(int(visual->shape_colors[0].r) == 0);
+  CHECK(int(visual->shape_colors[0].g) == 128);
+  CHECK(int(visual->shape_colors[0].b) == 128);
+  CHECK_FALSE(visual->shape_rotate);                        // character.shape_rotate: false
+  CHECK_FALSE(visual->npc_enabled);                         // npc.enabled: false
+  CHECK_FALSE(visual->distractors_enabled);                 // distractors.enabled: false
+}
 
 TEST_CASE("the generated source of simplest.yaml matches its golden", "[codegen][golden]") {
   const kage::GeneratedSource g = generate_file("configs/throughput/simplest.yaml");

@@ -1,5 +1,6 @@
 // The kagec command line through run_kagec with string streams: exit codes
 // 0/1/2, did-you-mean for commands, the frozen JSON diagnostic format.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -130,12 +131,12 @@ TEST_CASE("json format prints the frozen diagnostic fields", "[cli][json]") {
 TEST_CASE("diff --certify: usage errors, certified and failing pairs", "[cli][diff]") {
   const std::string train = "configs/kage_bench/bases/shape_black.yaml";
   const std::string eval = "configs/kage_bench/background/1-eval.yaml";
-  CHECK(kagec({"diff", "--certify", "colour", train, eval}).code == 2);
-  CHECK(kagec({"diff", "--certify", "latent", train, eval}).code == 2);
-  const CliRun ok = kagec({"diff", train, eval, "--certify", "background"});
+  CHECK(kagec({"diff", "--certify=colour", train, eval}).code == 2);
+  CHECK(kagec({"diff", "--axis", "latent", train, eval}).code == 2);
+  const CliRun ok = kagec({"diff", train, eval, "--axis", "background"});
   CHECK(ok.code == 0);
   CHECK(ok.out.find("certified: exactly one visual axis changes (background), nothing latent") != std::string::npos);
-  const CliRun wrong = kagec({"diff", train, eval, "--certify", "filters"});
+  const CliRun wrong = kagec({"diff", train, eval, "--certify=filters"});
   CHECK(wrong.code == 1);
   CHECK(wrong.out.find("not certified: declared axis 'filters' does not change") != std::string::npos);
   const CliRun same = kagec({"diff", train, train, "--certify"});
@@ -143,6 +144,59 @@ TEST_CASE("diff --certify: usage errors, certified and failing pairs", "[cli][di
   CHECK(same.out.find("no effective differences") != std::string::npos);
   CHECK(same.out.find("degenerate pair") != std::string::npos);
   CHECK(kagec({"diff", train, eval}).code == 0);  // without --certify a diff is information only
+  // The old spelling with the axis as a separate word is a usage error that says how to write it.
+  const CliRun old = kagec({"diff", "--certify", "background", train, eval});
+  CHECK(old.code == 2);
+  CHECK(old.err.find("--axis background or --certify=background") != std::string::npos);
+}
+
+TEST_CASE("diff: every order of the files, --certify, the axis and -o gives the same certificate", "[cli][diff]") {
+  const std::string train = "configs/kage_bench/bases/shape_black.yaml";
+  const std::string eval = "configs/kage_bench/background/1-eval.yaml";
+  TempDir tmp("diff_orders");
+  const std::string cert = (tmp.path() / "cert.json").string();
+  // Each option group stays together; the files keep their order (TRAIN before EVAL).
+  for (const std::vector<std::string>& axis :
+       {std::vector<std::string>{"--certify"}, {"--certify=background"}, {"--axis", "background"},
+        {"--certify", "--axis", "background"}}) {
+    std::vector<std::vector<std::string>> groups = {{train}, {eval}, axis, {"-o", cert}};
+    std::vector<int> order = {0, 1, 2, 3};
+    int runs = 0;
+    do {
+      if (std::find(order.begin(), order.end(), 0) > std::find(order.begin(), order.end(), 1)) continue;
+      std::vector<std::string> args = {"diff"};
+      for (int g : order) args.insert(args.end(), groups[g].begin(), groups[g].end());
+      fs::remove(cert);
+      const CliRun r = kagec(args);
+      std::string line;
+      for (const std::string& a : args) line += a + " ";
+      INFO(line << "\n" << r.err);
+      CHECK(r.code == 0);
+      CHECK(r.out.find("certified: exactly one visual axis changes (background)") != std::string::npos);
+      const nlohmann::json j = nlohmann::json::parse(read_text(cert), nullptr, false);
+      REQUIRE_FALSE(j.is_discarded());
+      CHECK(j.dump().find("shape_black.yaml") != std::string::npos);
+      ++runs;
+    } while (std::next_permutation(order.begin(), order.end()));
+    CHECK(runs == 12);
+  }
+}
+
+TEST_CASE("resolve -o reports a write that fails", "[cli][resolve]") {
+  const CliRun full = kagec({"resolve", "tests/lint/no-diagnostics.yaml", "-o", "/dev/full"});
+  CHECK(full.code == 1);
+  CHECK(full.err.find("kagec resolve: cannot write '/dev/full': write failed") != std::string::npos);
+}
+
+TEST_CASE("diff -o reports a write that fails", "[cli][diff]") {
+  const CliRun full = kagec({"diff", "configs/kage_bench/bases/shape_black.yaml",
+                             "configs/kage_bench/background/1-eval.yaml", "--certify", "-o", "/dev/full"});
+  CHECK(full.code == 1);
+  CHECK(full.err.find("kagec diff: cannot write '/dev/full': write failed") != std::string::npos);
+  const CliRun dir = kagec({"diff", "configs/kage_bench/bases/shape_black.yaml",
+                            "configs/kage_bench/background/1-eval.yaml", "-o", "/nonexistent-dir/cert.json"});
+  CHECK(dir.code == 1);
+  CHECK(dir.err.find("cannot write '/nonexistent-dir/cert.json'") != std::string::npos);
 }
 
 TEST_CASE("resolve prints the canonical Spec, or nothing when there are errors", "[cli][resolve]") {

@@ -5,6 +5,7 @@
 #include "compiler/diff.h"
 #include "compiler/suite.h"
 #include "test_support.h"
+#include "tests/skip.h"
 
 namespace kage::test {
 namespace {
@@ -247,11 +248,8 @@ TEST_CASE("edited copies of the suite fail the edited pair only", "[suite]") {
 }
 
 TEST_CASE("the original's own files lint clean and certify like ours", "[suite][compat]") {
-  const fs::path shared_assets = "/work/shared/kage-assets";
-  if (!fs::is_directory(shared_assets)) {
-    WARN("skipped: the original's assets are not at " << shared_assets.string());
-    return;
-  }
+  const fs::path shared_assets = (source_dir() / "../shared/kage-assets").lexically_normal();
+  if (!fs::is_directory(shared_assets)) KAGE_SKIP("the original's assets are not at " << shared_assets.string());
   TempDir root("compat");
   fs::create_directories(root.path() / "src/kage_bench");
   fs::create_directory_symlink(shared_assets, root.path() / "src/kage_bench/assets");
@@ -285,6 +283,56 @@ TEST_CASE("the original's own files lint clean and certify like ours", "[suite][
     CHECK(p.cert.measured == mine.cert.measured);
     CHECK(p.cert.used_allowances.size() == mine.cert.used_allowances.size());
   }
+}
+
+}  // namespace kage::test
+
+namespace kage::test {
+
+TEST_CASE("the original's files, in its layout, lint clean without flags and hash as with --asset-root",
+          "[suite][compat][assets]") {
+  const fs::path shared_assets = (source_dir() / "../shared/kage-assets").lexically_normal();
+  if (!fs::is_directory(shared_assets)) KAGE_SKIP("the original's assets are not at " << shared_assets.string());
+  // The original's repository: configs under configs/, assets under src/kage_bench/assets, and every
+  // asset path written relative to the repository root, the working directory.
+  TempDir root("original_layout");
+  fs::create_directories(root.path() / "src/kage_bench");
+  fs::create_directory_symlink(shared_assets, root.path() / "src/kage_bench/assets");
+  fs::copy(source_dir() / "tests/compat/original", root.path() / "configs", fs::copy_options::recursive);
+  const fs::path home = fs::current_path();
+  fs::current_path(root.path());
+  DiskFileReader reader;
+  ResolveOptions with_root;
+  with_root.asset_root = root.path().string();
+  size_t files = 0, noted = 0;
+  std::map<std::string, std::string> hashes;  // file -> Spec hash, resolved from the root without flags
+  for (const auto& e : fs::recursive_directory_iterator("configs")) {
+    if (!e.is_regular_file() || e.path().extension() != ".yaml") continue;
+    Analysis a;
+    analyze(a, e.path().string(), reader);
+    INFO(e.path().string() << "\n" << a.dump());
+    REQUIRE(a.spec);
+    CHECK(a.diags.error_count() == 0);
+    noted += a.count("asset-cwd-relative") > 0;
+    Analysis b;
+    analyze(b, e.path().string(), reader, with_root);
+    REQUIRE(b.spec);
+    CHECK(b.spec->sha256() == a.spec->sha256());
+    hashes[e.path().string()] = a.spec->sha256();
+    ++files;
+  }
+  CHECK(files == 69);
+  CHECK(noted > 30);  // most name an image or sprite folder
+  // From another directory, with --asset-root: the same hashes (the Spec does not record where it ran).
+  fs::current_path(source_dir());
+  for (const auto& [file, hash] : hashes) {
+    Analysis c;
+    analyze(c, (root.path() / file).string(), reader, with_root);
+    INFO(file << "\n" << c.dump());
+    REQUIRE(c.spec);
+    CHECK(c.spec->sha256() == hash);
+  }
+  fs::current_path(home);
 }
 
 }  // namespace kage::test

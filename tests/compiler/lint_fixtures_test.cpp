@@ -196,6 +196,8 @@ const std::map<std::string, std::string>& rules_without_fixture() {
       {"file-unreadable",
        "only a file named on the command line can be unreadable (a missing base is extends-missing); "
        "covered by the 'kagec lint of a missing file' test in cli_test.cpp"},
+      {"extends-too-deep",
+       "needs a chain of more than 64 files; covered by the 'a deep extends chain' test in hostile_input_test.cpp"},
   };
   return m;
 }

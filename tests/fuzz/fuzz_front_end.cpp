@@ -4,7 +4,9 @@
 // Properties: no crash or hang; every diagnostic range lies inside its
 // buffer; printing works; and when the input resolves without errors, the
 // canonical JSON is a fixpoint (canonical -> spec_from_json -> canonical) and
-// a second run gives the same bytes.
+// a second run gives the same bytes. The config sits (in memory) among the shipped configs, so its
+// `extends:` and asset paths reach real files; the inputs that reach the fixpoint are counted, and the
+// callers require some (a run where every input failed to resolve would prove nothing).
 //
 // Built as a libFuzzer target with -DKAGE_FUZZ_MAIN (tests/fuzz/run_fuzz.sh);
 // kage_compiler_tests calls kage::fuzz_front_end_one without the fuzzer runtime.
@@ -25,18 +27,27 @@ namespace kage {
 
 namespace {
 
-// The config under test, and a base it may name with `extends: base.yaml`.
+namespace fs = std::filesystem;
+
+const std::string kConfigs = fs::path(KAGE_SOURCE_DIR "/configs").lexically_normal().string();
+// Beside the KAGE-Bench pairs, whose `extends: ../bases/...` and `../../../assets/...` then resolve.
+const std::string kDir = kConfigs + "/kage_bench/fuzz";
+
+// The config under test and a base it may name with `extends: base.yaml`, in memory; any other file
+// under configs/ from the disk, so that the shipped bases can be extended.
 class FuzzReader final : public FileReader {
  public:
   std::map<std::string, std::string> files;
   std::optional<std::string> read(const std::string& path, std::string* err) override {
-    const auto it = files.find(std::filesystem::path(path).lexically_normal().string());
-    if (it == files.end()) {
-      if (err) *err = "no such file";
-      return std::nullopt;
-    }
-    return it->second;
+    const std::string key = fs::path(path).lexically_normal().string();
+    if (const auto it = files.find(key); it != files.end()) return it->second;
+    if (key.rfind(kConfigs + "/", 0) == 0 && key.find("/..") == std::string::npos) return disk_.read(key, err);
+    if (err) *err = "no such file";
+    return std::nullopt;
   }
+
+ private:
+  DiskFileReader disk_;
 };
 
 constexpr const char* kBase =
@@ -50,14 +61,13 @@ struct Outcome {
 
 Outcome run_once(const std::string& text) {
   FuzzReader reader;
-  reader.files["fuzz/config.yaml"] = text;
-  reader.files["fuzz/base.yaml"] = kBase;
+  reader.files[kDir + "/config.yaml"] = text;
+  reader.files[kDir + "/base.yaml"] = kBase;
   SourceManager sources;
   DiagEngine diags(sources);
-  ResolveOptions options;
-  options.asset_root = "/nonexistent-kagec-fuzz-assets";  // assets never exist: resolve reports them
+  const ResolveOptions options;
   std::optional<Spec> spec;
-  if (auto config = load_config("fuzz/config.yaml", sources, reader, diags))
+  if (auto config = load_config(kDir + "/config.yaml", sources, reader, diags))
     spec = analyze_composed(*config, options, sources, diags);
   Outcome out;
   for (const Diagnostic& d : diags.sorted()) {
@@ -81,8 +91,10 @@ Outcome run_once(const std::string& text) {
 
 }  // namespace
 
-/// One input; returns a description of the first violated property, or "".
-std::string fuzz_front_end_one(const uint8_t* data, size_t size) {
+/// One input; returns a description of the first violated property, or "". `fixpoint`, if given, says
+/// whether the input resolved and went through the whole parse -> resolve -> dump fixpoint check.
+std::string fuzz_front_end_one(const uint8_t* data, size_t size, bool* fixpoint) {
+  if (fixpoint) *fixpoint = false;
   const std::string text(reinterpret_cast<const char*>(data), size);
   const Outcome first = run_once(text);
   if (!first.problem.empty() || first.canonical.empty()) return first.problem;
@@ -94,14 +106,28 @@ std::string fuzz_front_end_one(const uint8_t* data, size_t size) {
   if (parsed.at("sha256") != back->sha256()) return "hash of the re-read Spec differs";
   const Outcome second = run_once(text);
   if (second.canonical != first.canonical) return "two runs give different canonical JSON";
+  if (fixpoint) *fixpoint = true;
   return {};
 }
 
 }  // namespace kage
 
 #ifdef KAGE_FUZZ_MAIN
+namespace {
+size_t g_fixpoints = 0;
+// run_fuzz.sh reads this line and fails when no input reached the fixpoint.
+void report_fixpoints() { std::fprintf(stderr, "fuzz_front_end: %zu inputs reached the fixpoint\n", g_fixpoints); }
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  std::atexit(report_fixpoints);
+  return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string problem = kage::fuzz_front_end_one(data, size);
+  bool fixpoint = false;
+  const std::string problem = kage::fuzz_front_end_one(data, size, &fixpoint);
+  g_fixpoints += fixpoint;
   if (!problem.empty()) {
     std::fprintf(stderr, "fuzz_front_end: %s\n", problem.c_str());
     std::abort();

@@ -23,12 +23,18 @@ find "$root/configs" "$root/tests/lint" -name '*.yaml' -type f | while read -r f
   cp "$f" "$corpus/seed_$(echo "$f" | sha1sum | cut -c1-16).yaml"
 done
 
-cd "$build"  # the target reads nothing from disk except through asset paths, which never exist
+cd "$build"  # the target reads configs/ and assets/ of the source tree, nothing else
 status=0
 "$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -max_len=8192 \
-  -artifact_prefix="$artifacts/" -print_final_stats=1 "$corpus" || status=$?
+  -artifact_prefix="$artifacts/" -print_final_stats=1 "$corpus" 2> >(tee "$build/fuzz.log" >&2) || status=$?
+wait  # for tee
 if [ "$status" -ne 0 ]; then
   echo "run_fuzz.sh: the fuzzer found a problem (exit $status); inputs are in $artifacts" >&2
   exit 1
 fi
-echo "run_fuzz.sh: no crash in ${seconds}s"
+fixpoints=$(sed -n 's/^fuzz_front_end: \([0-9]*\) inputs reached the fixpoint$/\1/p' "$build/fuzz.log" | tail -1)
+if [ -z "$fixpoints" ] || [ "$fixpoints" -eq 0 ]; then
+  echo "run_fuzz.sh: no input reached the parse -> resolve -> dump fixpoint; the run proved nothing" >&2
+  exit 1
+fi
+echo "run_fuzz.sh: no crash in ${seconds}s; ${fixpoints} inputs reached the fixpoint"

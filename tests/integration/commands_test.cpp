@@ -64,3 +64,22 @@ TEST_CASE("kagec render writes frames, a GIF and a contact sheet", "[integration
   CHECK(f0.image->width == 128);
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("render and bench refuse what cannot fit, and report writes that fail", "[integration][render][hostile]") {
+  const std::string config = kRoot + "/configs/throughput/simplest.yaml";
+  std::string out, err;
+  CHECK(kagec({"render", config, "--steps", "100000000", "--sheet", "/tmp/never.png"}, out, err) == 2);
+  CHECK(err.find("a contact sheet holds at most 1024 frames") != std::string::npos);
+  // 2e9 frames of 48 KiB: more than any disk here; refused before the first step.
+  CHECK(kagec({"render", config, "--steps", "2000000000", "--every", "1", "-o", "/tmp/kage_never_frames"}, out, err) == 1);
+  CHECK(err.find("would take up to") != std::string::npos);
+  CHECK(err.find("add --force") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists("/tmp/kage_never_frames"));
+  CHECK(kagec({"render", config, "--steps", "20", "--gif", "/dev/full"}, out, err) == 1);
+  CHECK(err.find("kagec render: /dev/full: write failed") != std::string::npos);
+  CHECK(kagec({"render", config, "--steps", "20", "--sheet", "/dev/full"}, out, err) == 1);
+  CHECK(err.find("kagec render: /dev/full: write failed") != std::string::npos);
+  CHECK(kagec({"bench", config, "--cpu", "--envs", "100000000", "--steps", "1"}, out, err) == 1);
+  CHECK(err.find("cannot build 100000000 environments of 128x128 observations: they need 9") != std::string::npos);
+  CHECK(err.find("use fewer environments or smaller observations") != std::string::npos);
+}

@@ -12,6 +12,7 @@
 #include "runtime/host/asset_pack.h"
 #include "runtime/host/asset_scan.h"
 #include "runtime/host/image_io.h"
+#include "tests/skip.h"
 
 namespace {
 
@@ -64,10 +65,7 @@ kage::AssetPackResult load_all(const std::string& root) {
 }  // namespace
 
 TEST_CASE("the original's shipped assets reproduce spec 3.5", "[assets]") {
-  if (!fs::is_directory(kOriginal)) {
-    WARN("skipped: no " << kOriginal);
-    return;
-  }
+  if (!fs::is_directory(kOriginal)) KAGE_SKIP("the original's assets are not at " << kOriginal);
   const auto bgs = kage::scan_background_dir(kOriginal + "/backgrounds");
   REQUIRE(bgs);
   REQUIRE(bgs->size() == 128);
@@ -168,10 +166,7 @@ TEST_CASE("our asset pack is complete and our own", "[assets]") {
   CHECK(narrow >= 3);
   CHECK(semi > 0);
 
-  if (!fs::is_directory(kOriginal)) {
-    WARN("byte comparison skipped: no " << kOriginal);
-    return;
-  }
+  if (!fs::is_directory(kOriginal)) KAGE_SKIP("byte comparison: the original's assets are not at " << kOriginal);
   std::set<std::string> theirs;
   for (const auto& e : fs::recursive_directory_iterator(kOriginal)) {
     if (e.is_regular_file()) theirs.insert(read_bytes(e.path().string()));

@@ -1,0 +1,21 @@
+# Fails unless the cubin CUBIN holds code for every kernel in KERNELS: nvcc gives each kernel its own
+# `.text.<name>` section, so a kernel that was compiled away or never instantiated has none.
+#   cmake -DCUBIN=file.cubin -DKERNELS="a;b" -P check_cubin_kernels.cmake
+if(NOT EXISTS "${CUBIN}")
+  message(FATAL_ERROR "${CUBIN}: no such cubin; build the kage_semantics_nvcc_check target")
+endif()
+file(STRINGS "${CUBIN}" sections REGEX "^\\.text\\.")
+set(found 0)
+foreach(kernel ${KERNELS})
+  list(FIND sections ".text.${kernel}" at)
+  if(at EQUAL -1)
+    message(SEND_ERROR "${CUBIN}: no code section for kernel ${kernel}")
+  else()
+    math(EXPR found "${found} + 1")
+  endif()
+endforeach()
+list(LENGTH KERNELS expected)
+if(NOT found EQUAL expected OR expected EQUAL 0)
+  message(FATAL_ERROR "${found} of ${expected} kernels have code")
+endif()
+message(STATUS "${CUBIN}: code for all ${found} kernels")
