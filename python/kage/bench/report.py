@@ -3,10 +3,12 @@
 Input, as `python3 -m kage.bench run` writes it:
 
     DIR/suite.json                 the suite's pairs (kagec suite): names, axes, sweeps, certificates
-    DIR/bench.json                 the seeds asked for (optional here)
+    DIR/bench.json                 the seeds and units asked for, and under --share-training each
+                                   pair's shared run and label (optional here)
     DIR/runs/<unit>/seed_<s>/      a kage.train run directory: a plain pair's (unit = the pair's name, eval
-                                   label "eval") or a sweep's (unit = the sweep's name, one eval label per
-                                   eval config: its name in the sweep)
+                                   label "eval"), a sweep's (unit = the sweep's name, one eval label per
+                                   eval config: its name in the sweep), or a shared run's (several plain
+                                   pairs with one train config, one eval label per pair)
 
 The protocol is the paper's (kage-ppo-baseline.md §5), in three levels:
 1. per run: each value's maximum over the run's evaluation points (summary.json's "max"), the train side
@@ -48,7 +50,7 @@ import os
 import re
 import statistics
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Dict, List, NoReturn, Optional, Sequence, Tuple
 
 from kage.bench import plots
@@ -72,6 +74,10 @@ class Unit:
     name: str
     is_sweep: bool
     pairs: List[dict]  # the suite.json entries
+    labels: Dict[str, str] = field(default_factory=dict)  # pair -> eval label, where not label_of's
+
+    def label(self, pair: dict) -> str:
+        return self.labels.get(pair["pair"], label_of(pair))
 
 
 @dataclass
@@ -119,12 +125,20 @@ def read_bench(bench_dir: str) -> dict:
     return bench if isinstance(bench, dict) else {}
 
 
-def units_of(suite: dict, selected: Optional[List[str]] = None) -> List[Unit]:
+def units_of(suite: dict, selected: Optional[List[str]] = None,
+             shared: Optional[Dict[str, List[str]]] = None) -> List[Unit]:
     """The suite's plain pairs and sweeps in manifest order, as kage.bench run trains them; only the
-    `selected` ones (bench.json's "units": what `run --pairs` chose) when given."""
+    `selected` ones (bench.json's "units": what `run --pairs` chose) when given. `shared` (bench.json's, under
+    --share-training) puts a pair in the shared run that trained it: {pair: [unit, label]}."""
+    shared = shared or {}
     units: Dict[str, Unit] = {}
     for pair in suite["pairs"]:
-        if pair["sweep"] is None:
+        if pair["pair"] in shared:
+            name, label = shared[pair["pair"]]
+            unit = units.setdefault(name, Unit(name, False, []))
+            unit.pairs.append(pair)
+            unit.labels[pair["pair"]] = label
+        elif pair["sweep"] is None:
             units[pair["pair"]] = Unit(pair["pair"], False, [pair])
         else:
             units.setdefault(pair["sweep"], Unit(pair["sweep"], True, [])).pairs.append(pair)
@@ -286,7 +300,7 @@ def aggregate(units: List[Unit], runs: Dict[str, List[Run]]) -> dict:
         finished = [r for r in runs[unit.name] if r.stats is not None]
         results = {}
         for pair in unit.pairs:
-            label = label_of(pair)
+            label = unit.label(pair)
             per_run = []
             for run in finished:
                 values = run_maxima(run.stats, label, os.path.join(run.path, "summary.json"))
@@ -297,7 +311,7 @@ def aggregate(units: List[Unit], runs: Dict[str, List[Run]]) -> dict:
                 "pair": pair["pair"], "axis": pair["declared_axis"], "certified": pair.get("certified"),
                 "n_seeds": len(finished), "seeds": [r.seed for r in finished], "metrics": over_seeds(per_run)}
         if not unit.is_sweep:
-            pairs.append(results[unit.name])
+            pairs.extend(results[p["pair"]] for p in unit.pairs)
             continue
         by_name = {p["sweep_eval"]: results[p["pair"]] for p in unit.pairs}
         evals = [dict(by_name[name], sweep_eval=name) for name in sweep_order(list(by_name))]
@@ -357,11 +371,13 @@ def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], lev
         if unit.is_sweep or not evaluations:
             continue
         unfinished = sum(1 for r in runs[unit.name] if r.evaluations and r.stats is None)
-        title = unit.name + (f" ({len(evaluations)} runs, {unfinished} unfinished)" if unfinished else "")
-        for metric, suffix, ylabel, ylim in ((SUCCESS_SHOWN, "", "success rate (success_once)", (0, 1.1)),
-                                             ("return", "_return", "return", None)):
-            figures[f"plots/curves_{safe(unit.name)}{suffix}.png"] = plots.training_curves(
-                title, curve(evaluations, None, metric), curve(evaluations, PLAIN_LABEL, metric), ylabel, ylim)
+        for pair in unit.pairs:
+            title = pair["pair"] + (f" ({len(evaluations)} runs, {unfinished} unfinished)" if unfinished else "")
+            for metric, suffix, ylabel, ylim in ((SUCCESS_SHOWN, "", "success rate (success_once)", (0, 1.1)),
+                                                 ("return", "_return", "return", None)):
+                figures[f"plots/curves_{safe(pair['pair'])}{suffix}.png"] = plots.training_curves(
+                    title, curve(evaluations, None, metric), curve(evaluations, unit.label(pair), metric), ylabel,
+                    ylim)
     if levels["axes"]:
         drops = [a["metrics"][SUCCESS_SHOWN]["drop_pct"] for a in levels["axes"]]
         figures["plots/drop_per_axis.png"] = plots.drop_per_axis([a["axis"] for a in levels["axes"]], drops)
@@ -383,7 +399,7 @@ def report(bench_dir: str, out_dir: Optional[str] = None) -> dict:
     suite = load_suite(bench_dir)
     bench = read_bench(bench_dir)
     out_dir = out_dir or os.path.join(bench_dir, "report")
-    units = units_of(suite, bench.get("units"))
+    units = units_of(suite, bench.get("units"), bench.get("shared"))
     runs = {unit.name: find_runs(bench_dir, unit) for unit in units}
     levels = aggregate(units, runs)
     status = run_status(units, runs, [s for s in bench.get("seeds", []) if isinstance(s, int)])

@@ -1,15 +1,16 @@
-"""python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [--pack K] [--task I | --gpus all|0,2]
-[trainer flags]
+"""python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [--pack K] [--share-training]
+[--task I | --gpus all|0,2] [trainer flags]
 
 Trains every (pair, seed) of a suite manifest with `python3 -m kage.train`, each run in its own run
 directory, one process after the other; --pack K trains K runs at once in one process (one GPU), which
 the learner's batched forward and backward make several times faster in aggregate. The runs form a fixed
 task table (kage.bench.tasks): --task I trains task I alone (a Slurm array task, kage.bench slurm), and
 --gpus keeps one worker per GPU busy with the tasks (kage.bench.gpus). An --agent that cannot be
-packed trains its runs one at a time.
+packed trains its runs one at a time. --share-training trains pairs that share a train config once per
+seed, in one run that evaluates all their eval configs (the 34 pairs of KAGE-Bench have 7 train configs).
 
     DIR/suite.json                  the suite's report (kagec suite): pairs, axes, paths, spec hashes, certificates
-    DIR/bench.json                  the manifest, the seeds asked for so far and the trainer flags
+    DIR/bench.json                  the manifest, the seeds asked for so far, the trainer flags and the shared runs
     DIR/tasks.json                  the task table: the runs of each task
     DIR/runs/<pair>/seed_<s>/       a training run (kage.train's run directory), its train.log and
                                     bench_state.json (running, failed or stopped: kage.bench.run_state)
@@ -50,6 +51,7 @@ class Unit:
     train: str
     evals: List[str]
     labels: List[str]
+    pairs: List[str] = dataclasses.field(default_factory=list)  # --share-training: the pairs, one per label
 
 
 def parse_seeds(text: str) -> List[int]:
@@ -95,6 +97,35 @@ def units_of(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
     return chosen
 
 
+MAX_EVALS = 10  # eval configs per run (kage.train's limit, §3.5)
+
+
+def share_training(units: List[Unit], report: dict) -> List[Unit]:
+    """--share-training: plain pairs whose train configs have one Spec train once per seed, in one run that
+    evaluates all their eval configs (at most MAX_EVALS a run), each under its pair's name as label. A run
+    depends only on its train config, seed and flags, so these pairs' separate runs would train the same
+    agent; the suite's 34 pairs have 7 train configs. Sweeps and pairs with a train config of their own stay."""
+    train_hash = {p["pair"]: p["train"]["spec_sha256"] for p in report["pairs"] if p["sweep"] is None}
+    groups: Dict[str, List[Unit]] = {}
+    for unit in units:
+        if unit.name in train_hash:
+            groups.setdefault(train_hash[unit.name], []).append(unit)
+    shared: Dict[str, List[Unit]] = {}
+    for spec_hash, members in groups.items():
+        if len(members) < 2:
+            continue
+        stem = os.path.splitext(os.path.basename(members[0].train))[0]
+        chunks = [members[i:i + MAX_EVALS] for i in range(0, len(members), MAX_EVALS)]
+        for number, chunk in enumerate(chunks, 1):
+            part = f"-part{number}" if len(chunks) > 1 else ""
+            shared[chunk[0].name] = [Unit(f"shared/{stem}-{spec_hash[:8]}{part}", "(shared)", chunk[0].train,
+                                          [u.evals[0] for u in chunk], [u.name.replace("/", "_") for u in chunk],
+                                          [u.name for u in chunk])]
+            for u in chunk[1:]:
+                shared[u.name] = []
+    return [v for u in units for v in shared.get(u.name, [u])]
+
+
 def check_suite_unchanged(out: str, report: dict) -> None:
     """Refuses a DIR started on configs whose Specs have changed since."""
     path = os.path.join(out, "suite.json")
@@ -114,19 +145,28 @@ def check_suite_unchanged(out: str, report: dict) -> None:
                     "restore it, or run into another --out")
 
 
-def record_bench(out: str, manifest: str, seeds: List[int], units: List[str], trainer_args: List[str]) -> None:
-    """bench.json: the manifest, the trainer flags of the first run (later runs must use the same), and the
-    seeds and units (pairs, sweeps) asked for so far, which the report covers."""
+def record_bench(out: str, manifest: str, seeds: List[int], units: List[Unit], trainer_args: List[str],
+                 share: bool) -> None:
+    """bench.json: the manifest, the trainer flags of the first run (later runs must use the same), the
+    seeds and units (pairs, sweeps, shared runs) asked for so far, which the report covers, and under
+    --share-training where each pair's results are ({pair: [unit, label]})."""
     path = os.path.join(out, "bench.json")
+    names = [u.name for u in units]
+    shared = {pair: [u.name, label] for u in units for pair, label in zip(u.pairs, u.labels)}
     if os.path.exists(path):
         with open(path) as f:
             previous = json.load(f)
         if previous["trainer_args"] != trainer_args:
             raise SystemExit(f"kage.bench: {out} was started with trainer flags {previous['trainer_args']}, now "
                              f"{trainer_args}: use the same flags (results must share one protocol), or another --out")
+        if previous.get("share_training", False) != share:
+            raise SystemExit(f"kage.bench: {out} was started {'with' if not share else 'without'} "
+                             "--share-training: use the same, or another --out")
         seeds = sorted(set(previous["seeds"]) | set(seeds))
-        units = previous["units"] + [u for u in units if u not in previous["units"]]
-    write_json(path, {"kage_bench": 1, "suite": manifest, "seeds": seeds, "units": units, "trainer_args": trainer_args})
+        names = previous["units"] + [u for u in names if u not in previous["units"]]
+        shared = {**previous.get("shared", {}), **shared}
+    write_json(path, {"kage_bench": 1, "suite": manifest, "seeds": seeds, "units": names, "trainer_args": trainer_args,
+                      "share_training": share, "shared": shared})
 
 
 def train_flags(unit: Unit, seed: int, run_dir: str, trainer_args: List[str]) -> List[str]:
@@ -229,6 +269,7 @@ class Bench:
     seeds: List[int]
     steps_per_run: int
     device: str
+    share_training: bool
 
     def table(self) -> List[List[tasks.Job]]:
         return tasks.task_table(self.units, self.seeds, self.pack, self.out)
@@ -237,7 +278,8 @@ class Bench:
         """`python3 -m kage.bench run` with this benchmark's arguments (append --task I)."""
         pairs = ["--pairs", *self.pairs] if self.pairs else []
         return [sys.executable, "-m", "kage.bench", "run", self.suite, "--seeds", self.seeds_text, "--out", self.out,
-                "--pack", str(self.pack), *pairs, *self.trainer_args]
+                "--pack", str(self.pack), *pairs, *(["--share-training"] if self.share_training else []),
+                *self.trainer_args]
 
 
 def add_bench_arguments(parser: argparse.ArgumentParser) -> None:
@@ -247,6 +289,8 @@ def add_bench_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", required=True, help="the benchmark directory (created, or continued)")
     parser.add_argument("--pairs", nargs="+", help="only these pairs or sweeps (by name)")
     parser.add_argument("--pack", type=int, default=1, help="train K runs at once in one process (default 1)")
+    parser.add_argument("--share-training", action="store_true",
+                        help="train pairs that share a train config once per seed, evaluating all their eval configs")
 
 
 def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
@@ -272,16 +316,18 @@ def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
     except ConfigError as e:
         raise SystemExit(f"{e}\nkage.bench: fix the suite first") from None
     units = units_of(report, args.pairs)
+    if args.share_training:
+        units = share_training(units, report)
     for p in report["pairs"]:
         if not p["certified"] and any(p["pair"] == u.name or p["sweep"] == u.name for u in units):
             print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
 
     os.makedirs(out, exist_ok=True)
     check_suite_unchanged(out, report)
-    record_bench(out, suite, seeds, [u.name for u in units], trainer_args)
+    record_bench(out, suite, seeds, units, trainer_args, args.share_training)
     write_json(os.path.join(out, "suite.json"), report)
     bench = Bench(suite, out, args.seeds, args.pairs, args.pack, trainer_args, units, seeds,
-                  probe.num_iterations * probe.batch_size, probe.device)
+                  probe.num_iterations * probe.batch_size, probe.device, args.share_training)
     tasks.write_task_table(out, bench.table(), args.pack)
     return bench
 
