@@ -6,6 +6,7 @@
 #include <optional>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -175,6 +176,34 @@ TEST_CASE("the latent section depends only on the latent parameters", "[codegen]
   kage::LatentParams l = base.config.latent;
   l.gravity *= 2.0f;
   CHECK(kage::generate_latent_section(l) != section);
+}
+
+TEST_CASE("float parameters are written so that they read back bit for bit", "[codegen]") {
+  kage::LatentParams p{};
+  p.gravity = 0.75f;                                         // short exact decimal
+  p.jump_velocity = -0.3f;                                   // hex, with its shortest decimal
+  p.max_speed_x = -0.0f;                                     // the sign of zero is kept
+  p.terminal_velocity = 1e20f;                               // long exact expansion: hex
+  p.ground_friction = std::numeric_limits<float>::denorm_min();
+  p.air_resistance = std::numeric_limits<float>::infinity();  // spelled by its bits
+  const std::string section = kage::generate_latent_section(p);
+  const auto value = [&](const std::string& name) {
+    const auto n = named(section, "LatentParams latent()", name);
+    REQUIRE(n);
+    return *n;
+  };
+  CHECK(value("gravity").value == "0.75f");
+  CHECK(value("jump_velocity").value == "-0x1.333334p-2f");
+  CHECK(value("jump_velocity").note == "-0.3");
+  CHECK(value("max_speed_x").value == "-0.0f");
+  for (const char* name : {"terminal_velocity", "ground_friction"}) {
+    INFO(name);
+    CHECK(value(name).value.starts_with("0x1"));
+  }
+  CHECK(std::strtof(value("terminal_velocity").value.c_str(), nullptr) == 1e20f);
+  CHECK(std::strtof(value("ground_friction").value.c_str(), nullptr) == std::numeric_limits<float>::denorm_min());
+  CHECK(value("air_resistance").value == "__builtin_bit_cast(float, 0x7f800000u)");
+  CHECK(value("air_resistance").note == "inf");
 }
 
 TEST_CASE("param words round-trip the lowered structs", "[codegen]") {
