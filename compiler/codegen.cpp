@@ -1,13 +1,19 @@
-// Codegen: fills templates/*.in with the lowered parameters' words. The templates hold only includes,
-// the config type and the instantiations; every decision was made by lowering.
+// Codegen: fills templates/*.in with the lowered parameters as named initialisers. The templates hold
+// only includes, the config type and the instantiations; every decision was made by lowering.
 #include "compiler/codegen.h"
 
+#include <bit>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string_view>
+#include <type_traits>
 
 #include "compiler/build.h"
 #include "compiler/internal_error.h"
+#include "compiler/lower.h"
 #include "runtime/host/sha256.h"
 
 namespace kage {
@@ -30,17 +36,101 @@ std::vector<uint32_t> words_of(T p) {
   return w;
 }
 
-/// Words as hex literals, eight per line, indented for the initializer.
-std::string format_words(const std::vector<uint32_t>& w) {
-  std::string out;
-  char buf[16];
-  for (size_t i = 0; i < w.size(); ++i) {
-    if (i % 8 == 0) out += i == 0 ? "      " : "\n      ";
-    std::snprintf(buf, sizeof buf, "0x%08xu,", w[i]);
-    out += buf;
-    if (i % 8 != 7 && i + 1 != w.size()) out += ' ';
+/// A float as a literal that any conforming compiler reads back bit for bit: its exact decimal
+/// expansion where that is short (0.5f, -7.5f, 490.0f), else hex (0x1.333334p-2f) with the shortest
+/// decimal that rounds to it as the note (0.3). Non-finite values are spelled by their bits.
+std::string float_literal(float v, std::string& note) {
+  char buf[160];
+  if (!std::isfinite(v)) {
+    note = std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
+    std::snprintf(buf, sizeof buf, "__builtin_bit_cast(float, 0x%08xu)", std::bit_cast<uint32_t>(v));
+    return buf;
   }
-  return out;
+  char exact[160];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  std::snprintf(exact, sizeof exact, "%.120g", v);  // glibc prints a float's expansion exactly
+  std::string literal;
+  if (std::strcmp(buf, exact) == 0) {
+    literal = buf;
+    if (literal.find_first_of(".e") == std::string::npos) literal += ".0";
+  } else {
+    std::snprintf(buf, sizeof buf, "%a", v);
+    literal = buf;
+    char shortest[32];
+    const auto r = std::to_chars(shortest, shortest + sizeof shortest, v);
+    note.assign(shortest, r.ptr);
+  }
+  literal += 'f';
+  const float back = std::strtof(literal.c_str(), nullptr);
+  KAGE_INTERNAL_ASSERT(std::bit_cast<uint32_t>(back) == std::bit_cast<uint32_t>(v),
+                       "float literal " + literal + " does not read back as its value");
+  return literal;
+}
+
+/// A value as a C++ initialiser; `type` is its spelling in the parameter list, `note` collects what the
+/// literal alone does not say (a float's decimal, an enum value's config name).
+std::string literal(const char*, int32_t v, std::string&) { return std::to_string(v); }
+std::string literal(const char*, bool v, std::string&) { return v ? "true" : "false"; }
+std::string literal(const char*, float v, std::string& note) { return float_literal(v, note); }
+std::string literal(const char*, Rgb c, std::string&) {
+  return "{" + std::to_string(c.r) + ", " + std::to_string(c.g) + ", " + std::to_string(c.b) + "}";
+}
+template <class E>
+  requires std::is_enum_v<E>
+std::string literal(const char* type, E v, std::string& note) {
+  note = config_name(v);
+  return std::string(type) + "(" + std::to_string(static_cast<int32_t>(v)) + ")";
+}
+
+/// A fixed-size list up to its last non-zero entry and at least its first (a zero entry can mean
+/// something: ShapeType(0) is a circle); the rest is zero, as the initialiser leaves it.
+template <class T, size_t N>
+std::string literal(const char* type, const T (&list)[N], std::string& note) {
+  size_t n = N;
+  const T zero{};
+  while (n > 1 && std::memcmp(&list[n - 1], &zero, sizeof(T)) == 0) --n;
+  std::string out = "{";
+  for (size_t i = 0; i < n; ++i) {
+    std::string entry_note;
+    out += (i ? ", " : "") + literal(type, list[i], entry_note);
+    if (!entry_note.empty()) note += (note.empty() ? "" : ", ") + entry_note;
+  }
+  return out + "}";
+}
+
+/// One designated initialiser per member, in the order of the parameter list (.def), one per line:
+/// `.gravity = 0.75f,` with a trailing `// note` where the literal needs one.
+class Initialisers {
+ public:
+  template <class T>
+  void add(const char* name, const char* type, const T& value) {
+    std::string note;
+    text_ += "      ." + std::string(name) + " = " + literal(type, value, note) + ",";
+    if (!note.empty()) text_ += "  // " + note;
+    text_ += '\n';
+  }
+  std::string text() const { return text_.substr(0, text_.size() - 1); }
+
+ private:
+  std::string text_;
+};
+
+std::string initialisers(const LatentParams& p) {
+  Initialisers out;
+#define KAGE_PARAM(type, name) out.add(#name, #type, p.name);
+#include "runtime/latent/latent_params.def"
+#undef KAGE_PARAM
+  return out.text();
+}
+
+std::string initialisers(const VisualParams& p) {
+  Initialisers out;
+#define KAGE_PARAM(type, name) out.add(#name, #type, p.name);
+#define KAGE_PARAM_ARRAY(type, name, count) out.add(#name, #type, p.name);
+#include "runtime/visual/visual_params.def"
+#undef KAGE_PARAM_ARRAY
+#undef KAGE_PARAM
+  return out.text();
 }
 
 /// Replaces every @NAME@ of `text`; a placeholder without a value is a compiler bug.
@@ -87,9 +177,7 @@ std::string template_hash() {
 }
 
 std::string generate_latent_section(const LatentParams& p) {
-  const std::vector<uint32_t> w = param_words(p);
-  return fill(chomp(latent_section_inc_template_text()),
-              {{"LATENT_WORD_COUNT", std::to_string(w.size())}, {"LATENT_WORDS", format_words(w)}});
+  return fill(chomp(latent_section_inc_template_text()), {{"LATENT_FIELDS", initialisers(p)}});
 }
 
 GeneratedSource generate_source(const CodegenInput& in) {
@@ -101,7 +189,6 @@ GeneratedSource generate_source(const CodegenInput& in) {
   g.latent_section = generate_latent_section(in.latent);
   g.latent_hash = sha256_hex(g.latent_section);
   g.template_hash = template_hash();
-  const std::vector<uint32_t> vw = param_words(in.visual);
   g.text = fill(kernels_cu_template_text(), {
                                              {"FILE_NAME", g.file_name},
                                              {"CODEGEN_VERSION", std::to_string(kCodegenVersion)},
@@ -114,8 +201,7 @@ GeneratedSource generate_source(const CodegenInput& in) {
                                              {"VISUAL_BYTES", std::to_string(sizeof(VisualParams))},
                                              {"CONFIG_NAME", g.config_name},
                                              {"LATENT_SECTION", g.latent_section},
-                                             {"VISUAL_WORD_COUNT", std::to_string(vw.size())},
-                                             {"VISUAL_WORDS", format_words(vw)},
+                                             {"VISUAL_FIELDS", initialisers(in.visual)},
                                          });
   return g;
 }

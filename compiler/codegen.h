@@ -12,7 +12,7 @@
 namespace kage {
 
 /// Bumped whenever the generated text changes for the same inputs and templates.
-inline constexpr int kCodegenVersion = 1;
+inline constexpr int kCodegenVersion = 2;
 
 /// What the generator reads: the Spec's hash and its lowered parameters.
 struct CodegenInput {

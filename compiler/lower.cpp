@@ -75,6 +75,11 @@ const char* const kPresetNames[] = {"none", "vintage", "retro", "cyberpunk", "ho
 const char* const kModeNames[] = {"black", "image", "noise", "color"};
 
 template <size_t N>
+const char* name_at(const char* const (&names)[N], int32_t i) {
+  return i >= 0 && static_cast<size_t>(i) < N ? names[i] : "?";
+}
+
+template <size_t N>
 int32_t index_of(const char* const (&names)[N], const std::string& name, int32_t fallback) {
   for (size_t i = 0; i < N; ++i)
     if (name == names[i]) return static_cast<int32_t>(i);
@@ -359,5 +364,9 @@ void report_capacity(const ComposedConfig& config, const Spec& spec, DiagEngine&
 }
 
 bool capacity_limit_known(const std::string& id) { return find_capacity_limit(id) != nullptr; }
+
+const char* config_name(BackgroundMode mode) { return name_at(kModeNames, static_cast<int32_t>(mode)); }
+const char* config_name(ShapeType shape) { return name_at(kShapeNames, static_cast<int32_t>(shape)); }
+const char* config_name(Preset preset) { return name_at(kPresetNames, static_cast<int32_t>(preset)); }
 
 }  // namespace kage

@@ -48,6 +48,12 @@ LowerResult lower_spec(const Spec& spec);
 /// (at the file itself when the key is inherited from a default).
 void report_capacity(const ComposedConfig& config, const Spec& spec, DiagEngine& diags);
 
+/// The config's spelling of a lowered enum value (a background.mode, a shape type, a filter preset);
+/// "?" for a value outside the enum.
+const char* config_name(BackgroundMode mode);
+const char* config_name(ShapeType shape);
+const char* config_name(Preset preset);
+
 /// Whether lowering knows the storage bound an `x-kage-capacity` entry of the schema names.
 bool capacity_limit_known(const std::string& id);
 

@@ -6,6 +6,7 @@
 #include <optional>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -59,56 +60,72 @@ std::string read(const std::string& path) {
   return s.str();
 }
 
-/// The hex words of the initializer that follows `marker` in a generated source, decoded as T.
-template <class T>
-std::optional<T> decode_words(const std::string& text, const std::string& marker) {
-  size_t at = text.find(marker);
-  if (at == std::string::npos) return std::nullopt;
-  at = text.find("Words{{", at);
-  const size_t end = text.find("}}", at);
-  if (at == std::string::npos || end == std::string::npos) return std::nullopt;
-  std::vector<uint32_t> words;
-  std::istringstream in(text.substr(at + 7, end - at - 7));
-  std::string token;
-  while (in >> token) words.push_back(static_cast<uint32_t>(std::stoul(token.substr(0, token.find('u')), nullptr, 16)));
-  if (words.size() * 4 != sizeof(T)) return std::nullopt;
-  T out;
-  std::memcpy(&out, words.data(), sizeof out);
-  return out;
+/// One member's line of a generated parameter initialiser, split into its literal and its note.
+struct Named {
+  std::string value;  ///< the initialiser as written, without the trailing comma
+  std::string note;   ///< the text of the trailing `// ` comment, if any
+};
+
+/// The line `.name = value,  // note` of the initialiser that follows `marker` in a generated source.
+std::optional<Named> named(const std::string& text, const std::string& marker, const std::string& name) {
+  const size_t begin = text.find(marker);
+  if (begin == std::string::npos) return std::nullopt;
+  const size_t end = text.find("\n    };", begin);
+  const std::string key = "\n      ." + name + " = ";
+  const size_t at = text.find(key, begin);
+  if (at == std::string::npos || at > end) return std::nullopt;
+  const size_t from = at + key.size();
+  const std::string line = text.substr(from, text.find('\n', from) - from);
+  const size_t note_at = line.find(",  // ");
+  if (note_at != std::string::npos) return Named{line.substr(0, note_at), line.substr(note_at + 6)};
+  if (!line.ends_with(',')) return std::nullopt;
+  return Named{line.substr(0, line.size() - 1), ""};
 }
 
 }  // namespace
 
 TEST_CASE("the committed golden holds the values of simplest.yaml, by name", "[codegen][golden]") {
   // Written by hand from configs/default.yaml and configs/kage_bench/bases/shape_black.yaml (which
-  // simplest.yaml extends), so the golden's words are checked against the config and not against the
+  // simplest.yaml extends), so the golden's lines are checked against the config and not against the
   // generator that wrote them.
   const std::string golden = read(kRoot + "tests/codegen/simplest.expected.cu");
-  const auto latent = decode_words<kage::LatentParams>(golden, "LatentParams latent()");
-  const auto visual = decode_words<kage::VisualParams>(golden, "VisualParams visual()");
-  REQUIRE(latent);
-  REQUIRE(visual);
-  CHECK(latent->screen_h == 128);                   // H: 128
-  CHECK(latent->screen_w == 128);                   // W: 128
-  CHECK(latent->char_width == 16);                  // character.width: 16
-  CHECK(latent->length == 2048);                    // layout.length: 2048
-  CHECK(latent->gravity == 0.75f);                  // physics.gravity: 0.75
-  CHECK(latent->jump_velocity == -7.5f);            // physics.jump_force: -7.5
-  CHECK(latent->max_speed_x == 1.0f);               // physics.move_speed: 1
-  CHECK(latent->episode_length == 500);             // episode_length: 500
-  CHECK(latent->dist_to_success == 490.0f);         // dist_to_success: 490
-  CHECK(visual->H == 128);
-  CHECK(visual->W == 128);
-  CHECK(visual->bg_mode == kage::BackgroundMode::kBlack);  // background.mode: "black"
-  CHECK_FALSE(visual->use_sprites);                         // character.use_sprites: false
-  CHECK(visual->use_shape);                                 // character.use_shape: true
-  REQUIRE(visual->shape_color_count == 1);                  // character.shape_colors: ["teal"]
-  CHECK(int(visual->shape_colors[0].r) == 0);
-  CHECK(int(visual->shape_colors[0].g) == 128);
-  CHECK(int(visual->shape_colors[0].b) == 128);
-  CHECK_FALSE(visual->shape_rotate);                        // character.shape_rotate: false
-  CHECK_FALSE(visual->npc_enabled);                         // npc.enabled: false
-  CHECK_FALSE(visual->distractors_enabled);                 // distractors.enabled: false
+  const auto latent = [&](const std::string& name) {
+    INFO("LatentParams::" << name);
+    const auto n = named(golden, "LatentParams latent()", name);
+    REQUIRE(n);
+    return *n;
+  };
+  const auto visual = [&](const std::string& name) {
+    INFO("VisualParams::" << name);
+    const auto n = named(golden, "VisualParams visual()", name);
+    REQUIRE(n);
+    return *n;
+  };
+  CHECK(latent("screen_h").value == "128");             // H: 128
+  CHECK(latent("screen_w").value == "128");             // W: 128
+  CHECK(latent("char_width").value == "16");            // character.width: 16
+  CHECK(latent("length").value == "2048");              // layout.length: 2048
+  CHECK(latent("gravity").value == "0.75f");            // physics.gravity: 0.75
+  CHECK(latent("jump_velocity").value == "-7.5f");      // physics.jump_force: -7.5
+  CHECK(latent("max_speed_x").value == "1.0f");         // physics.move_speed: 1
+  CHECK(latent("episode_length").value == "500");       // episode_length: 500
+  CHECK(latent("dist_to_success").value == "490.0f");   // dist_to_success: 490
+  // layout.p_change: 0.7, so 1 - 0.7 in double, rounded to float: written exactly in hex, noted in decimal.
+  CHECK(std::strtof(latent("layout_t_flat").value.c_str(), nullptr) == 0.3f);
+  CHECK(latent("layout_t_flat").note == "0.3");
+  CHECK(visual("H").value == "128");
+  CHECK(visual("W").value == "128");
+  CHECK(visual("bg_mode").value == "BackgroundMode(0)");  // background.mode: "black"
+  CHECK(visual("bg_mode").note == "black");
+  CHECK(visual("use_sprites").value == "false");          // character.use_sprites: false
+  CHECK(visual("use_shape").value == "true");             // character.use_shape: true
+  CHECK(visual("shape_color_count").value == "1");        // character.shape_colors: ["teal"]
+  CHECK(visual("shape_colors").value == "{{0, 128, 128}}");
+  CHECK(visual("shape_types").value == "{ShapeType(0)}");  // character.shape_types: ["circle"]
+  CHECK(visual("shape_types").note == "circle");
+  CHECK(visual("shape_rotate").value == "false");         // character.shape_rotate: false
+  CHECK(visual("npc_enabled").value == "false");          // npc.enabled: false
+  CHECK(visual("distractors_enabled").value == "false");  // distractors.enabled: false
 }
 
 TEST_CASE("the generated source of simplest.yaml matches its golden", "[codegen][golden]") {
@@ -159,6 +176,34 @@ TEST_CASE("the latent section depends only on the latent parameters", "[codegen]
   kage::LatentParams l = base.config.latent;
   l.gravity *= 2.0f;
   CHECK(kage::generate_latent_section(l) != section);
+}
+
+TEST_CASE("float parameters are written so that they read back bit for bit", "[codegen]") {
+  kage::LatentParams p{};
+  p.gravity = 0.75f;                                         // short exact decimal
+  p.jump_velocity = -0.3f;                                   // hex, with its shortest decimal
+  p.max_speed_x = -0.0f;                                     // the sign of zero is kept
+  p.terminal_velocity = 1e20f;                               // long exact expansion: hex
+  p.ground_friction = std::numeric_limits<float>::denorm_min();
+  p.air_resistance = std::numeric_limits<float>::infinity();  // spelled by its bits
+  const std::string section = kage::generate_latent_section(p);
+  const auto value = [&](const std::string& name) {
+    const auto n = named(section, "LatentParams latent()", name);
+    REQUIRE(n);
+    return *n;
+  };
+  CHECK(value("gravity").value == "0.75f");
+  CHECK(value("jump_velocity").value == "-0x1.333334p-2f");
+  CHECK(value("jump_velocity").note == "-0.3");
+  CHECK(value("max_speed_x").value == "-0.0f");
+  for (const char* name : {"terminal_velocity", "ground_friction"}) {
+    INFO(name);
+    CHECK(value(name).value.starts_with("0x1"));
+  }
+  CHECK(std::strtof(value("terminal_velocity").value.c_str(), nullptr) == 1e20f);
+  CHECK(std::strtof(value("ground_friction").value.c_str(), nullptr) == std::numeric_limits<float>::denorm_min());
+  CHECK(value("air_resistance").value == "__builtin_bit_cast(float, 0x7f800000u)");
+  CHECK(value("air_resistance").note == "inf");
 }
 
 TEST_CASE("param words round-trip the lowered structs", "[codegen]") {
