@@ -1,4 +1,5 @@
-# Installs the build into PREFIX, then, with the installed kagec only:
+# Installs the build into PREFIX, checks that the installed kagec loads no library from the build tree,
+# then, with the installed kagec only:
 #  1. proves that generated sources include the installed headers: with an #error planted in
 #     PREFIX/share/kagec/runtime/kage_hd.h, `kagec compile` must fail on exactly that line;
 #  2. compiles CONFIG for the CPU (kernels_host.so built against the installed headers) and runs the
@@ -17,6 +18,19 @@ if(NOT EXISTS ${kagec} OR NOT EXISTS ${header})
   message(FATAL_ERROR "the install lacks ${kagec} or ${header}")
 endif()
 unset(ENV{KAGE_ROOT})
+
+# The build tree may be removed after an install: no shared library of the installed kagec may resolve there.
+file(GET_RUNTIME_DEPENDENCIES EXECUTABLES ${kagec} RESOLVED_DEPENDENCIES_VAR resolved
+     UNRESOLVED_DEPENDENCIES_VAR unresolved)
+if(unresolved)
+  message(FATAL_ERROR "the installed kagec needs libraries that are not found: ${unresolved}")
+endif()
+foreach(library ${resolved})
+  string(FIND "${library}" "${BUILD}/" at)
+  if(at EQUAL 0)
+    message(FATAL_ERROR "the installed kagec loads ${library} from the build tree: install that library too")
+  endif()
+endforeach()
 
 file(READ ${header} original)
 file(WRITE ${header} "#error kage-install-test: the installed header was used\n${original}")
