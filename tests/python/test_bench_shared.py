@@ -67,3 +67,17 @@ def test_shared_training_trains_once_and_reports_each_pair(tmp_path):
                               "--seeds", "1", "--out", str(shared), *TINY], cwd=ROOT, capture_output=True, text=True,
                              timeout=300)
     assert refused.returncode != 0 and "--share-training" in refused.stderr
+
+
+def test_shared_training_reaches_array_tasks(tmp_path):
+    """kage.bench slurm passes --share-training on to every task; the 340 runs of 10 seeds become 90."""
+    out = tmp_path / "array"
+    bench("slurm", "suites/kage_bench.yaml", "--seeds", "1-10", "--pack", "8", "--out", str(out),
+                 "--share-training")
+    script = (out / "slurm" / "kage_bench.sbatch").read_text()
+    assert "--share-training --task" in script
+    table = json.loads((out / "tasks.json").read_text())["tasks"]
+    runs = [(r["unit"], r["seed"]) for task in table for r in task]
+    assert len(runs) == len(set(runs)) == 90
+    shared = json.loads((out / "bench.json").read_text())["shared"]
+    assert len(shared) == 30  # the 34 pairs but the 4 with a train config of their own
