@@ -1,10 +1,12 @@
 """Stopping on request: SIGTERM (a scheduler's preemption, `timeout`, `kill`) or SIGINT (Ctrl-C) lets the
 running iteration finish, then the trainer checkpoints and exits, so a rerun resumes with nothing lost.
 A second Ctrl-C stops at once (the run then resumes from its previous checkpoint); a repeated SIGTERM
-changes nothing, since schedulers and kage.bench may both send one."""
+changes nothing, since schedulers and kage.bench may both send one. The runners stop their child processes
+through stop_children."""
 import signal
+import subprocess
 import sys
-from typing import Optional
+from typing import List, Optional
 
 SIGNALS = (signal.SIGTERM, signal.SIGINT)
 
@@ -43,3 +45,20 @@ class StopRequest:
     def exit_code(self) -> int:
         return 128 + (self.signum or 0)  # the shell's convention for "ended by signal N"
 
+
+
+def stop_children(children: List[subprocess.Popen], grace_s: float = 180) -> None:
+    """SIGTERM to each running child (a trainer then checkpoints after its running iteration, an evaluation
+    point included; a `kage.bench run --task` process stops its trainer the same way), then SIGKILL to any
+    still running after `grace_s`: a run resumes from its last checkpoint either way. Further SIGTERMs to
+    this process are ignored meanwhile, so a repeated scancel cannot cut the wait short."""
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    for child in children:
+        if child.poll() is None:
+            child.terminate()
+    for child in children:
+        try:
+            child.wait(timeout=grace_s)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            child.wait()

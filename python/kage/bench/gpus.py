@@ -14,6 +14,7 @@ import time
 from typing import List
 
 from kage.bench import tasks
+from kage.stop import stop_children
 
 FAKE_GPUS = "KAGE_BENCH_FAKE_GPUS"
 
@@ -98,9 +99,8 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
     except BaseException:  # Stop (SIGTERM) or Ctrl-C: the children stop their runs and keep the checkpoints
         stopping.set()
         with lock:
-            for child in children.values():
-                if child.poll() is None:
-                    child.send_signal(signal.SIGTERM)
+            running = list(children.values())
+        stop_children(running)
         for thread in threads:
             thread.join(timeout=60)
         print("kage.bench run: stopped; run again to resume", file=sys.stderr, flush=True)

@@ -40,6 +40,7 @@ from kage import _kage, plugins
 from kage.bench import gpus, run_state, tasks
 from kage.errors import ConfigError
 from kage.files import atomic_write, write_json
+from kage.stop import stop_children
 
 
 @dataclasses.dataclass
@@ -356,7 +357,7 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
         label = labels[0] if len(pack) == 1 else f"pack of {len(pack)} ({labels[0]}, ...)"
         run_state.mark(run_dirs, "running", task=task, log=log_path)
         with open(log_path, "ab") as log:
-            # Its own session: a terminal's Ctrl-C or a kill of our process group reaches it through stop_child.
+            # Its own session: a terminal's Ctrl-C or a kill of our process group reaches it through stop_children.
             child = subprocess.Popen([sys.executable, "-m", "kage.train", *command], stdout=log, stderr=log,
                                      start_new_session=True)
             try:
@@ -368,7 +369,7 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
                         beat = time.monotonic()
                     time.sleep(1.0)
             except (Stop, KeyboardInterrupt):
-                stop_child(child)
+                stop_children([child])
                 run_state.mark(run_dirs, "stopped", task=task, log=log_path)
                 print(f"\nkage.bench run: stopped {', '.join(labels)}; run again (or requeue) to resume them from "
                       "their last checkpoints", file=sys.stderr, flush=True)
@@ -389,18 +390,6 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
               file=sys.stderr)
         return 1
     return 0
-
-
-def stop_child(child: subprocess.Popen) -> None:
-    """SIGTERM, which makes the trainer checkpoint after its running iteration (an evaluation point
-    included), then SIGKILL after a grace period: the run resumes from its last checkpoint either way."""
-    if child.poll() is None:
-        child.terminate()
-    try:
-        child.wait(timeout=180)
-    except subprocess.TimeoutExpired:
-        child.kill()
-        child.wait()
 
 
 def main(argv: List[str]) -> int:
