@@ -21,14 +21,5 @@ for set in fp32 fast; do
     --pack 4 --out "$dir/pack4-$set" "${common[@]}" "${flags[@]}" >"$dir-pack4-$set.log" 2>&1 &
 done
 wait
-python3 - "$dir" <<'PY'
-import glob, json, os, sys
-for path in sorted(glob.glob(os.path.join(sys.argv[1], "**", "metrics.jsonl"), recursive=True)):
-    rows = [json.loads(l) for l in open(path)]
-    evals = "  ".join(f"{r['iteration']}: {r['train']['return']:.0f} ({r['train']['success_once']:.2f})"
-                      for r in rows if r["kind"] == "eval")
-    entropy = " ".join(f"{r['losses/entropy']:.2f}" if r["losses/entropy"] is not None else "nan"
-                       for r in rows if r["kind"] == "train" and r["iteration"] % 20 == 0)
-    print(f"{os.path.relpath(os.path.dirname(path), sys.argv[1])}\n  eval {evals}\n  entropy/20 it {entropy}")
-PY
+python3 bench/learning_summary.py "$dir"
 tail -n 2 "$dir"-*.log

@@ -14,12 +14,4 @@ for flag in fp32 bf16 channels-last fused-input; do
     --total-timesteps "${STEPS:-2621440}" --run-eval-every 40 "${extra[@]}" >"$dir-$flag.log" 2>&1 &
 done
 wait
-python3 - "$dir" <<'PY'
-import glob, json, os, sys
-for path in sorted(glob.glob(os.path.join(sys.argv[1], "*", "metrics.jsonl"))):
-    rows = [json.loads(l) for l in open(path)]
-    evals = "  ".join(f"{r['iteration']}: {r['train']['return']:.0f} ({r['train']['success_once']:.2f})"
-                      for r in rows if r["kind"] == "eval")
-    entropy = " ".join(f"{r['losses/entropy']:.2f}" for r in rows if r["kind"] == "train" and r["iteration"] % 20 == 0)
-    print(f"{os.path.basename(os.path.dirname(path))}\n  eval {evals}\n  entropy/20 it {entropy}")
-PY
+python3 bench/learning_summary.py "$dir"

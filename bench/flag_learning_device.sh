@@ -29,12 +29,5 @@ for set in "all|--bf16 --channels-last --fused-input --cuda-graph"; do
     --pack 4 --out "$dir/pack4-${set%%|*}" "${common[@]}" ${set#*|} >"$dir-pack-${set%%|*}.log" 2>&1 &
 done
 wait
-python3 - "$dir" <<'PY'
-import glob, json, os, sys
-for path in sorted(glob.glob(os.path.join(sys.argv[1], "**", "metrics.jsonl"), recursive=True)):
-    rows = [json.loads(l) for l in open(path) if '"kind": "eval"' in l]
-    points = "  ".join(f"it {r['iteration']}: {r['train']['return']:8.1f} ({r['train']['success_once']:.2f})"
-                       for r in rows)
-    print(f"{os.path.relpath(os.path.dirname(path), sys.argv[1]):45s} {points}")
-PY
+python3 bench/learning_summary.py "$dir"
 tail -n 3 "$dir"-*.log
