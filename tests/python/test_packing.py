@@ -1,5 +1,7 @@
 """Packed runs (kage.bench run --pack K) follow the same algorithm as lone runs: two runs trained together
-end with the logs and parameters of the same two runs trained alone (CPU, float32).
+end with the logs and parameters of the same two runs trained alone (CPU, float32), also when the pack
+computes its convolutions as batched matrix products (--gemm-conv; three iterations, the first episodes
+ending in the third).
 
 Tolerance, from the arithmetic: a pack evaluates its runs with grouped convolutions and batched matrix
 products, a lone run with the ungrouped ones; both compute the same sums, possibly in another order, so
@@ -46,11 +48,13 @@ def compare_values(a, b, where):
         assert a == b, where
 
 
-def test_a_pack_of_two_equals_two_lone_runs(tmp_path):
+@pytest.mark.parametrize("pack_flags, total_timesteps", [({}, 192), ({"gemm_conv": True}, 96)],
+                         ids=["grouped-conv", "gemm-conv"])
+def test_a_pack_of_two_equals_two_lone_runs(tmp_path, pack_flags, total_timesteps):
     lone, packed = [], []
     for i, run in enumerate(RUNS):
-        lone.append(train.Args(**FLAGS, **run, out=str(tmp_path / f"lone{i}")))
-        packed.append(dataclasses.replace(lone[-1], out=str(tmp_path / f"packed{i}")))
+        lone.append(train.Args(**{**FLAGS, "total_timesteps": total_timesteps}, **run, out=str(tmp_path / f"lone{i}")))
+        packed.append(dataclasses.replace(lone[-1], out=str(tmp_path / f"packed{i}"), **pack_flags))
     for args in lone:
         train.train([args])
     train.train(packed)
