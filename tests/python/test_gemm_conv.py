@@ -43,7 +43,8 @@ def assert_close(got: torch.Tensor, expected: torch.Tensor, what: str) -> None:
 @pytest.mark.parametrize("fused", [False, True], ids=["frames", "fused-input"])
 @pytest.mark.parametrize("runs", [1, 3])
 def test_gemm_conv_computes_the_grouped_convolutions(runs, fused):
-    obs = torch.randint(0, 256, (runs, 5, HEIGHT, WIDTH, 3), dtype=torch.uint8, generator=torch.Generator().manual_seed(runs))
+    generator = torch.Generator().manual_seed(runs)
+    obs = torch.randint(0, 256, (runs, 5, HEIGHT, WIDTH, 3), dtype=torch.uint8, generator=generator)
     expected = outputs_and_gradients(network(runs, fused, gemm=False), obs)
     got = outputs_and_gradients(network(runs, fused, gemm=True), obs)
     assert got.keys() == expected.keys()

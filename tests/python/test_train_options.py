@@ -40,7 +40,8 @@ def test_every_option_at_once(tmp_path):
     (["--total-timesteps", "10"], "less than one batch"),
     (["--gemm-conv", "--channels-last"], "which --gemm-conv replaces (its activations are channels-last already): "
                                           "drop --channels-last"),
-    (["--agent", "lone_agent:make", "--gemm-conv"], "--gemm-conv rewrite the baseline's network: drop them with --agent"),
+    (["--agent", "lone_agent:make", "--gemm-conv"],
+     "--gemm-conv rewrite the baseline's network: drop them with --agent"),
 ])
 def test_flags_it_cannot_honour(flags, message, capsys):
     with pytest.raises(SystemExit):
