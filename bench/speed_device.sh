@@ -3,8 +3,6 @@
 # `python3 -m kage.bench speed` once per flag set, each line of SETS being "PACKS|TRAINER FLAGS"
 # (default below). Tables go to the output, JSON lines to $OUT/speed.jsonl. Run with carry [".deps"]:
 #   SETS=$'1,16|\n1,4,8,16,32|--bf16 --channels-last' bash bench/speed_device.sh
-# The convolutions as batched matmuls (--gemm-conv, which refuses --channels-last):
-#   SETS=$'8,16|--bf16 --fused-input --cuda-graph --gemm-conv' bash bench/speed_device.sh
 set -uo pipefail
 source bench/device_build.sh
 SETS=${SETS:-$'1,16|\n16|--bf16\n16|--bf16 --channels-last\n1,4,8,16,32|--bf16 --channels-last --cuda-graph'}

@@ -44,7 +44,6 @@ class Agent(nn.Module):
         self.critic_bias = nn.Parameter(torch.zeros(k, 1, 1, device=device))
         self.input_dtype = torch.float32  # bfloat16 under --bf16
         self.space_to_depth = False  # --fused-input
-        self.gemm_conv = False  # --gemm-conv
         with torch.no_grad():
             for run, seed in enumerate(seeds):
                 self._initialise(run, seed, channels)
@@ -64,8 +63,15 @@ class Agent(nn.Module):
 
     def forward(self, obs: torch.Tensor):
         """uint8 [K, B, H, W, C] frames -> logits [K, B, A] and values [K, B]. The first operation is the
-        conversion to float32 divided by 255 (§1.1)."""
-        x = self._torso_gemm(obs) if self.gemm_conv else self._torso_grouped(obs)
+        conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups."""
+        k, b, h, w, c = obs.shape
+        if self.space_to_depth:
+            x = F.relu(self._conv1_space_to_depth(obs))
+        else:
+            x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
+        x = F.relu(self.conv2(x))
+        x = F.relu(self.conv3(x))
+        x = x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
         hidden = F.relu(torch.baddbmm(self.fc_bias, x, self.fc_weight))
         # The heads always in float32, even under --bf16: values reach thousands (an untrained episode
         # returns about -3,900), where bfloat16's spacing is 16, more than a step's reward; rounded values
@@ -75,56 +81,6 @@ class Agent(nn.Module):
             logits = torch.baddbmm(self.actor_bias, hidden, self.actor_weight)
             value = torch.baddbmm(self.critic_bias, hidden, self.critic_weight).squeeze(-1)
         return logits, value
-
-    def _torso_grouped(self, obs: torch.Tensor) -> torch.Tensor:
-        """The convolutions with the runs' frames as channel groups -> [K, B, flat]."""
-        k, b, h, w, c = obs.shape
-        if self.space_to_depth:
-            x = F.relu(self._conv1_space_to_depth(obs))
-        else:
-            x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
-        x = F.relu(self.conv2(x))
-        x = F.relu(self.conv3(x))
-        return x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
-
-    def _torso_gemm(self, obs: torch.Tensor) -> torch.Tensor:
-        """The convolutions as im2col and one batched matrix product per layer, the run being the batch
-        index (--gemm-conv): one kernel per layer for all K runs, where cuDNN runs a grouped convolution
-        group by group. Activations stay [K, B, H, W, C] between layers. -> [K, B, flat]."""
-        k, b = obs.shape[:2]
-        if self.space_to_depth:
-            x = self._conv1_patches(obs)
-        else:
-            x = self._patches(obs.to(self.input_dtype).div_(255.0), self.conv1)
-        x = F.relu(self._patch_product(x, self.conv1))
-        x = F.relu(self._patch_product(self._patches(x, self.conv2), self.conv2))
-        x = F.relu(self._patch_product(self._patches(x, self.conv3), self.conv3))
-        # Each run's (channel, row, column) flatten, as the fc weight expects: permuting the activation
-        # costs less than permuting the fc weight in the rollout's small batches, and little in the update.
-        return x.permute(0, 1, 4, 2, 3).reshape(k, b, self.flat)
-
-    @staticmethod
-    def _patches(x: torch.Tensor, conv: nn.Conv2d) -> torch.Tensor:
-        """[K, B, H, W, C] -> the view [K, B, OH, OW, C, kh, kw] of every output position's input window,
-        in the (channel, row, column) order of the conv weight. unfold, not as_strided: its backward is
-        one efficient pass."""
-        (kh, kw), (sh, sw) = conv.kernel_size, conv.stride
-        return x.unfold(2, kh, sh).unfold(3, kw, sw)
-
-    def _conv1_patches(self, obs: torch.Tensor) -> torch.Tensor:
-        """conv1's patches straight from the uint8 frames, converted to the input dtype and divided by 255
-        in the same single pass (--fused-input under --gemm-conv); the quotient is computed in float32 and
-        rounded once, as autocast would round the float32 input."""
-        patches = self._patches(obs, self.conv1)
-        return torch.div(patches, 255.0, out=torch.empty(patches.shape, dtype=self.input_dtype, device=obs.device))
-
-    def _patch_product(self, patches: torch.Tensor, conv: nn.Conv2d) -> torch.Tensor:
-        """[K, B, OH, OW, C, kh, kw] patches -> the convolution's output [K, B, OH, OW, out]: one
-        baddbmm over the K runs of [B*OH*OW, C*kh*kw] patch rows by the run's [C*kh*kw, out] weight."""
-        k, b, oh, ow = patches.shape[:4]
-        weight = conv.weight.reshape(k, conv.out_channels // k, -1).transpose(1, 2)
-        out = torch.baddbmm(conv.bias.view(k, 1, -1), patches.reshape(k, b * oh * ow, -1), weight)
-        return out.view(k, b, oh, ow, -1)
 
     def _input(self, frames: torch.Tensor) -> torch.Tensor:
         """uint8 [B, H, W, C'] -> [B, C', H, W] / 255 in the input dtype, channels last when the weights are.

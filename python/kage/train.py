@@ -111,9 +111,6 @@ class Args:
     cuda_graph: bool = field(default=False, metadata={"help": "replay the rollout's policy step as a CUDA graph"})
     fused_input: bool = field(default=False, metadata={
         "help": "one pass from uint8 frames to 4x4 blocks in the network's dtype; conv1 as the equal 2x2 conv"})
-    gemm_conv: bool = field(default=False, metadata={
-        "help": "each convolution as im2col and one batched matmul over the packed runs (not cuDNN's grouped "
-                "convolution, group by group); with --fused-input conv1's patches come from the frames in one pass"})
 
     @property
     def batch_size(self) -> int:
@@ -186,12 +183,8 @@ def validate(args: Args) -> List[str]:
         problems.append("--bf16 and --cuda-graph are for --device cuda")
     if args.video_every < 0:
         problems.append("--video-every must not be negative")
-    if args.agent != plugins.BASELINE_AGENT and (args.fused_input or args.channels_last or args.gemm_conv):
-        problems.append("--fused-input, --channels-last and --gemm-conv rewrite the baseline's network: drop them "
-                        "with --agent")
-    if args.gemm_conv and args.channels_last:
-        problems.append("--channels-last lays out cuDNN's convolutions, which --gemm-conv replaces (its activations "
-                        "are channels-last already): drop --channels-last")
+    if args.agent != plugins.BASELINE_AGENT and (args.fused_input or args.channels_last):
+        problems.append("--fused-input and --channels-last rewrite the baseline's network: drop them with --agent")
     return problems
 
 
@@ -353,7 +346,6 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
         if args.bf16:
             agent.input_dtype = torch.bfloat16
         agent.space_to_depth = args.fused_input
-        agent.gemm_conv = args.gemm_conv
     augment = plugins.load_augment(args.augment)
     agent_spec = {"agent": args.agent, "observation_shape": [height, width, channels], "num_actions": num_actions,
                   "use_frame_stack": args.use_frame_stack}  # what kage.evaluate needs to rebuild a run's policy

@@ -38,10 +38,6 @@ def test_every_option_at_once(tmp_path):
     (["--num-minibatches", "3"], "must divide the batch"),
     (["--eval-config-paths", "a", "b", "--eval-config-labels", "x"], "gives 1 labels for 2 eval configs"),
     (["--total-timesteps", "10"], "less than one batch"),
-    (["--gemm-conv", "--channels-last"], "which --gemm-conv replaces (its activations are channels-last already): "
-                                          "drop --channels-last"),
-    (["--agent", "lone_agent:make", "--gemm-conv"],
-     "--gemm-conv rewrite the baseline's network: drop them with --agent"),
 ])
 def test_flags_it_cannot_honour(flags, message, capsys):
     with pytest.raises(SystemExit):
