@@ -44,7 +44,7 @@ std::optional<std::string> read_file(const fs::path& p) {
 }
 
 constexpr InfoFieldDesc kInfoFields[] = {
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) {InfoField::k##Enum, name, DType::dtype, doc},
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) {InfoField::k##Enum, name, DType::dtype, doc},
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
 };
@@ -62,7 +62,7 @@ const void* column_data(T* p) {
 template <class Table>
 const void* info_column(const Table& t, InfoField field) {
   switch (field) {
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) \
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) \
   case InfoField::k##Enum:                                     \
     return column_data(t.member);
 #include "runtime/info_fields.def"

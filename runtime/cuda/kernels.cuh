@@ -111,8 +111,8 @@ __device__ __forceinline__ void reset_body(const DeviceEnvs& e) {
   e.final_mask[env] = 0;
   if (e.reset_mask && !e.reset_mask[env]) return;
   LatentState ls;
-  device_reset_env(ParamsOf<Cfg>::latent(), ParamsOf<Cfg>::visual(), e.assets, device_episode_key(e, env, 0), 0,
-            e.segments + static_cast<int64_t>(env) * e.segment_stride, ls, e.visual[env]);
+  episode_reset(ParamsOf<Cfg>{}, e.assets, device_episode_key(e, env, 0), 0,
+                e.segments + static_cast<int64_t>(env) * e.segment_stride, ls, &e.visual[env]);
   e.latent[env] = ls;
   record_outcome(e, env, ls, StepOutcome{});
 }
@@ -124,8 +124,9 @@ __device__ __forceinline__ void step_body(const DeviceEnvs& e) {
   const int32_t env = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (env >= e.num_envs) return;
   LatentState ls = e.latent[env];
-  device_step_env(ParamsOf<Cfg>::latent(), ParamsOf<Cfg>::visual(), e, env,
-           e.segments + static_cast<int64_t>(env) * e.segment_stride, ls, e.visual[env]);
+  DeviceStepOut out{e, env};
+  episode_step(ParamsOf<Cfg>{}, e.assets, load_action(e.actions, env),
+               e.segments + static_cast<int64_t>(env) * e.segment_stride, ls, &e.visual[env], out);
   e.latent[env] = ls;
 }
 
@@ -160,7 +161,7 @@ __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh
 /// Uniform random actions in [0, 8) for step t (benchmarks), from their own key.
 __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n, uint64_t seed, uint32_t t) {
   const int32_t i = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (i < n) actions[i] = randint(fold(seed_key(seed), t), static_cast<uint32_t>(i), 0, 8);
+  if (i < n) actions[i] = benchmark_action(seed, t, static_cast<uint32_t>(i));
 }
 
 }  // namespace kage
