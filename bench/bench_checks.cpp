@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "runtime/cuda/device_batch.h"
-#include "runtime/host/host_batch.h"
+#include "runtime/cpu/host_batch.h"
 #include "runtime/visual/image_diff.h"
 
 namespace kage::bench {

@@ -16,9 +16,9 @@
 #include "compiler/compiled_dir.h"
 #include "compiler/lower.h"
 #include "compiler/resolve.h"
-#include "runtime/host/asset_pack.h"
-#include "runtime/host/host_batch.h"
-#include "runtime/host/specialized_assets.h"
+#include "runtime/io/asset_pack.h"
+#include "runtime/cpu/host_batch.h"
+#include "runtime/io/specialized_assets.h"
 #if defined(KAGE_API_HAVE_CUDA)
 #include "compiler/build.h"
 #include "runtime/cuda/device_batch.h"

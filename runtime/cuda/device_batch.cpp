@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "runtime/cuda/render_plan.h"
-#include "runtime/host/batch_state.h"
+#include "runtime/cpu/batch_state.h"
 #include "runtime/latent/latent_state.h"
 #include "runtime/visual/visual_state.h"
 

@@ -1,6 +1,6 @@
 // CPU batch runtime: static partition of the environments over std::threads; every environment is
 // independent, so the results are the same for any thread count.
-#include "runtime/host/cpu_batch.h"
+#include "runtime/cpu/cpu_batch.h"
 
 #include <algorithm>
 #include <thread>

@@ -1,12 +1,12 @@
 // CPU batch: the two HostKernels and the batch (threads, explicit reset, saved state); the episode
 // driver (runtime/episode.h) steps each environment.
-#include "runtime/host/host_batch.h"
+#include "runtime/cpu/host_batch.h"
 
 #include <algorithm>
 #include <cstring>
 #include <thread>
 
-#include "runtime/host/batch_state.h"
+#include "runtime/cpu/batch_state.h"
 
 namespace kage {
 namespace {

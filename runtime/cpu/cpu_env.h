@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "runtime/host/host_batch.h"
+#include "runtime/cpu/host_batch.h"
 #include "runtime/visual/asset_view.h"
 #include "runtime/visual/visual_params.h"
 #include "runtime/visual/visual_state.h"

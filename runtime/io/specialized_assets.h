@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "runtime/host/asset_pack.h"
+#include "runtime/io/asset_pack.h"
 
 namespace kage {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "runtime/host/cpu_batch.h"
-#include "runtime/host/specialized_env.h"
+#include "runtime/cpu/cpu_batch.h"
+#include "runtime/cpu/specialized_env.h"
 
 namespace kage {
 
@@ -51,7 +51,7 @@ class HostBatch {
   /// when info_shows_new_episode; reward and flags stay the finishing step's).
   void step(const int32_t* actions);
 
-  /// The saved state (runtime/host/batch_state.h) under `spec_hash`.
+  /// The saved state (runtime/cpu/batch_state.h) under `spec_hash`.
   std::vector<uint8_t> save_state(const std::string& spec_hash) const;
   /// Restores a saved state and renders its observations; the reason when it cannot, else empty.
   std::string load_state(const uint8_t* data, size_t size, const std::string& spec_hash);

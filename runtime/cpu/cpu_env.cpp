@@ -1,5 +1,5 @@
 // CPU environment: the checks of create(), then a HostBatch on the generic path.
-#include "runtime/host/cpu_env.h"
+#include "runtime/cpu/cpu_env.h"
 
 #include "runtime/latent/layout.h"
 
