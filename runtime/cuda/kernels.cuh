@@ -24,8 +24,8 @@ namespace kage {
 /// thread, the column table from the layout at `segments`, then the pixels. Entered by every thread of
 /// the group; the state in `sh` must be complete. `frame` is the float frame of the frame-pass path.
 template <class Cfg, class Group, class Slot>
-__device__ __forceinline__ void render_frame(const DeviceEnvs& e, int32_t env, Slot& sh, const uint8_t* segments,
-                                             float* frame, uint8_t* out) {
+__device__ __forceinline__ void group_render_frame(const DeviceEnvs& e, int32_t env, Slot& sh, const uint8_t* segments,
+                                                   float* frame, uint8_t* out) {
   const LatentParams& lp = ParamsOf<Cfg>::latent();
   const VisualParams& vp = ParamsOf<Cfg>::visual();
   if (Group::rank() == 0) {
@@ -143,7 +143,7 @@ __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh
     group_copy_words<BlockGroup>(&sh.latent, e.latent + env, static_cast<int32_t>(sizeof(LatentState)));
     group_copy_words<BlockGroup>(&sh.visual, e.visual + env, e.visual_extent);
     __syncthreads();
-    render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
+    group_render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
                                   frame_of<Cfg>(e.obs, env));
     __syncthreads();
     if (e.final_mask[env]) {
@@ -151,7 +151,7 @@ __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh
       group_copy_words<BlockGroup>(&sh.latent, e.final_latent + env, static_cast<int32_t>(sizeof(LatentState)));
       group_copy_words<BlockGroup>(&sh.visual, e.final_visual + env, e.visual_extent);
       __syncthreads();
-      render_frame<Cfg, BlockGroup>(e, env, sh, e.final_segments + static_cast<int64_t>(env) * e.segment_stride,
+      group_render_frame<Cfg, BlockGroup>(e, env, sh, e.final_segments + static_cast<int64_t>(env) * e.segment_stride,
                                     frame, frame_of<Cfg>(e.final_obs, env));
       __syncthreads();
     }
