@@ -124,9 +124,11 @@ __device__ __forceinline__ void step_body(const DeviceEnvs& e) {
   const int32_t env = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (env >= e.num_envs) return;
   LatentState ls = e.latent[env];
+  // Both addresses before the action's load, the order the PTX had before the episode driver.
   uint8_t* segments = e.segments + static_cast<int64_t>(env) * e.segment_stride;
+  VisualState* vs = &e.visual[env];
   DeviceStepOut out{e, env};
-  episode_step(ParamsOf<Cfg>{}, e.assets, load_action(e.actions, env), segments, ls, &e.visual[env], out);
+  episode_step(ParamsOf<Cfg>{}, e.assets, load_action(e.actions, env), segments, ls, vs, out);
   e.latent[env] = ls;
 }
 
