@@ -1,4 +1,4 @@
-// Correctness checks of the GPU batch against the CPU reference (same seeds and actions): latent
+// Correctness checks of the GPU batch against the CPU batch (same seeds and actions): latent
 // state and layout identical, visual state identical, observations within a tolerance; output
 // buffers poisoned before every checked launch so that unwritten bytes show.
 #pragma once

@@ -26,7 +26,7 @@
 #include "bench/gpu_measure.h"
 #include "runtime/cuda/device_batch.h"
 #include "runtime/cuda/module_loader.h"
-#include "runtime/host/specialized_assets.h"
+#include "runtime/io/specialized_assets.h"
 
 namespace kage::bench {
 namespace {

@@ -11,9 +11,9 @@
 
 #include "compiler/key_refs.h"
 #include "compiler/utf8.h"
-#include "runtime/host/asset_scan.h"
-#include "runtime/host/image_io.h"
-#include "runtime/host/sha256.h"
+#include "runtime/io/asset_scan.h"
+#include "runtime/io/image_io.h"
+#include "runtime/io/sha256.h"
 
 namespace kage {
 

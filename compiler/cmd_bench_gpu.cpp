@@ -20,7 +20,7 @@
 #include "compiler/codegen.h"
 #include "compiler/lower.h"
 #include "compiler/suite.h"
-#include "runtime/host/asset_pack.h"
+#include "runtime/io/asset_pack.h"
 
 namespace kage {
 

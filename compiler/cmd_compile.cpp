@@ -13,8 +13,8 @@
 #include "compiler/compiled_dir.h"
 #include "compiler/file_out.h"
 #include "compiler/lower.h"
-#include "runtime/host/sha256.h"
-#include "runtime/host/specialized_assets.h"
+#include "runtime/io/sha256.h"
+#include "runtime/io/specialized_assets.h"
 
 namespace kage {
 

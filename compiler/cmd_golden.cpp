@@ -8,7 +8,7 @@
 
 #include "compiler/cli_common.h"
 #include "compiler/lower.h"
-#include "runtime/host/golden_check.h"
+#include "verify/golden/golden_check.h"
 
 namespace kage {
 

@@ -9,8 +9,8 @@
 
 #include "compiler/cli_common.h"
 #include "compiler/environment.h"
-#include "runtime/host/gif_writer.h"
-#include "runtime/host/image_io.h"
+#include "runtime/io/gif_writer.h"
+#include "runtime/io/image_io.h"
 #include "runtime/rng.h"
 
 namespace kage {

@@ -14,7 +14,7 @@
 #include "compiler/build.h"
 #include "compiler/internal_error.h"
 #include "compiler/lower.h"
-#include "runtime/host/sha256.h"
+#include "runtime/io/sha256.h"
 
 namespace kage {
 

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "compiler/lower.h"
-#include "runtime/host/asset_pack.h"
-#include "runtime/host/cpu_env.h"
+#include "runtime/io/asset_pack.h"
+#include "runtime/cpu/cpu_env.h"
 
 namespace kage {
 

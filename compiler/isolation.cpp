@@ -6,7 +6,7 @@
 #include "compiler/codegen.h"
 #include "compiler/environment.h"
 #include "compiler/lower.h"
-#include "runtime/host/sha256.h"
+#include "runtime/io/sha256.h"
 
 namespace kage {
 

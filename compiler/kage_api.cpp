@@ -16,9 +16,9 @@
 #include "compiler/compiled_dir.h"
 #include "compiler/lower.h"
 #include "compiler/resolve.h"
-#include "runtime/host/asset_pack.h"
-#include "runtime/host/host_batch.h"
-#include "runtime/host/specialized_assets.h"
+#include "runtime/io/asset_pack.h"
+#include "runtime/cpu/host_batch.h"
+#include "runtime/io/specialized_assets.h"
 #if defined(KAGE_API_HAVE_CUDA)
 #include "compiler/build.h"
 #include "runtime/cuda/device_batch.h"
@@ -44,7 +44,7 @@ std::optional<std::string> read_file(const fs::path& p) {
 }
 
 constexpr InfoFieldDesc kInfoFields[] = {
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) {InfoField::k##Enum, name, DType::dtype, doc},
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) {InfoField::k##Enum, name, DType::dtype, doc},
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
 };
@@ -62,7 +62,7 @@ const void* column_data(T* p) {
 template <class Table>
 const void* info_column(const Table& t, InfoField field) {
   switch (field) {
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) \
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) \
   case InfoField::k##Enum:                                     \
     return column_data(t.member);
 #include "runtime/info_fields.def"

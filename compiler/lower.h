@@ -9,7 +9,7 @@
 #include "compiler/compose.h"
 #include "compiler/diag.h"
 #include "compiler/spec.h"
-#include "runtime/host/asset_pack.h"
+#include "runtime/io/asset_pack.h"
 #include "runtime/latent/latent_params.h"
 #include "runtime/visual/visual_params.h"
 

@@ -1,7 +1,7 @@
 // Spec: canonical JSON and hashing.
 #include "compiler/spec.h"
 
-#include "runtime/host/sha256.h"
+#include "runtime/io/sha256.h"
 
 namespace kage {
 

@@ -7,7 +7,6 @@
 
 #if defined(__CUDACC_RTC__)
 #define KAGE_HD __device__ __forceinline__
-#define KAGE_DEVICE_ONLY 1
 #elif defined(__CUDACC__)
 #define KAGE_HD __host__ __device__ __forceinline__
 #else

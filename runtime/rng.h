@@ -123,4 +123,10 @@ KAGE_UNROLL
   return Words4{{c0, c1, c2, c3}};
 }
 
+/// The uniform random action in [0, 8) of environment `env` at step t of a benchmark run (its own key,
+/// from `seed`): kage_sample_actions draws it on the GPU, the benchmark's CPU check on the host.
+KAGE_HD int32_t benchmark_action(uint64_t seed, uint32_t t, uint32_t env) {
+  return randint(fold(seed_key(seed), t), env, 0, 8);
+}
+
 }  // namespace kage

@@ -54,7 +54,7 @@ struct Options {
 
 /// The per-environment info fields (spec 5.8, plus the episode length): runtime/info_fields.def.
 enum class InfoField {
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) k##Enum,
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) k##Enum,
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
 };

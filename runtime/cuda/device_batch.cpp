@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "runtime/cuda/render_plan.h"
-#include "runtime/host/batch_state.h"
+#include "runtime/cpu/batch_state.h"
 #include "runtime/latent/latent_state.h"
 #include "runtime/visual/visual_state.h"
 
@@ -54,7 +54,7 @@ StateLayout state_layout(size_t n, size_t segment_stride) {
   l.final_segments = take(n * segment_stride);
   l.final_visual = take(n * sizeof(VisualState));
   int i = 0;
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) \
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) \
   l.info[i] = take(n * sizeof(ctype));                         \
   l.final_info[i++] = take(n * sizeof(ctype));
 #include "runtime/info_fields.def"
@@ -67,7 +67,7 @@ StateLayout state_layout(size_t n, size_t segment_stride) {
 InfoArrays info_arrays(CUdeviceptr base, const size_t* offsets) {
   InfoArrays a{};
   int i = 0;
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) a.member = reinterpret_cast<ctype*>(base + offsets[i++]);
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) a.member = reinterpret_cast<ctype*>(base + offsets[i++]);
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
   return a;
@@ -363,7 +363,7 @@ std::vector<StateSection> state_sections(const DeviceEnvs& e, const BatchStateLa
       {at(e.truncated), l.truncated, 1, 1},
   };
   int i = 0;
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) \
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) \
   s.push_back({at(e.info.member), l.info[i++], sizeof(ctype), sizeof(ctype)});
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD

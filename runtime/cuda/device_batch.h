@@ -87,7 +87,7 @@ class DeviceBatch {
   size_t obs_bytes_per_env() const { return obs_stride_; }
   int32_t segment_bytes() const { return segment_count_; }
 
-  /// The saved state (runtime/host/batch_state.h) under `spec_hash`; synchronises.
+  /// The saved state (runtime/cpu/batch_state.h) under `spec_hash`; synchronises.
   bool save_state(const std::string& spec_hash, std::vector<uint8_t>* out, std::string* error) const;
   /// Restores a saved state and renders its observations.
   bool load_state(const uint8_t* data, size_t size, const std::string& spec_hash, std::string* error);

@@ -13,6 +13,7 @@ namespace kage {
 /// writes them, and waits again.
 template <class Cfg>
 struct FramePass {
+  static constexpr bool kPasses = true;
   float* frame;
 
   __device__ __forceinline__ static int32_t pixel(int32_t k) {
@@ -90,6 +91,26 @@ struct FramePass {
     __syncthreads();
   }
 
+  /// fn(rgb, r, c) at every owned pixel, in place (walk_filters' per-pixel stages).
+  template <class Fn>
+  __device__ __forceinline__ void pixels(const Fn& fn) const {
+    const VisualParams& vp = ParamsOf<Cfg>::visual();
+#pragma unroll 1
+    for (int32_t i = static_cast<int32_t>(threadIdx.x); i < vp.H * vp.W; i += static_cast<int32_t>(blockDim.x))
+      fn(frame + i * 3, i / vp.W, i % vp.W);
+  }
+  /// The final per-pixel stage: the output staging truncates the values afterwards.
+  template <class Fn>
+  __device__ __forceinline__ void last_pixels(const Fn& fn) const {
+    pixels(fn);
+  }
+  /// Rounds the owned values to uint8 and back (7.1 A).
+  __device__ __forceinline__ void truncate() const {
+    pixels([](float* rgb, int32_t, int32_t) {
+      for (int32_t ch = 0; ch < 3; ++ch) rgb[ch] = static_cast<float>(to_u8_clipped(rgb[ch]));
+    });
+  }
+
   /// Blur (7.1 step 8): (1 - b)*F + b*Box3(F), as blur_pass.
   __device__ __forceinline__ void blur(float sigma) const {
     const VisualParams& vp = ParamsOf<Cfg>::visual();
@@ -142,52 +163,23 @@ struct FramePass {
   }
 };
 
-/// Frame-pass path in apply_filters' order: compose and the episode preset's pixel stages, its
-/// sharpen and the truncation to uint8 (7.1 A); the main chain with the pop_filter preset, head,
-/// blur, sharpen, pixelate, tail (B); then the lights (8.2). The bytes are staged in the frame's
-/// memory and stored with 16-byte words.
+/// Frame-pass path: compose into the float frame, the filter chain (walk_filters), then the lights
+/// (8.2). The bytes are staged in the frame's memory and stored with 16-byte words.
 template <class Cfg>
 __device__ __forceinline__ void render_frame_pass_path(const AssetView& assets, const BlockShared& sh,
                                                        const SpanSolid& solid, float* frame, uint8_t* out) {
   const VisualParams& vp = ParamsOf<Cfg>::visual();
   const FrameSetup& fs = sh.setup;
-  const FramePass<Cfg> pass{frame};
+  FramePass<Cfg> pass{frame};
   const int32_t n = vp.H * vp.W;
   const int32_t first = static_cast<int32_t>(threadIdx.x), stride = static_cast<int32_t>(blockDim.x);
-  const Preset ep = fs.episode_preset;
 #pragma unroll 1
   for (int32_t i = first; i < n; i += stride) {
     uint8_t rgb[3];
     compose_pixel(vp, assets, fs.agent, solid, sh.visual, fs.f, i / vp.W, i % vp.W, rgb);
-    float* f = frame + i * 3;
-    for (int32_t ch = 0; ch < 3; ++ch) f[ch] = static_cast<float>(rgb[ch]);
-    if (ep != Preset::kNone) preset_pixel_op(ep, f, i / vp.W, i % vp.W, vp.H, vp.W);
+    for (int32_t ch = 0; ch < 3; ++ch) frame[i * 3 + ch] = static_cast<float>(rgb[ch]);
   }
-  if (ep != Preset::kNone) {
-    const float amount = preset_sharpen_amount(ep);
-    if (amount > 0.0f) pass.sharpen(amount);
-#pragma unroll 1
-    for (int32_t i = first; i < n; i += stride)
-      for (int32_t ch = 0; ch < 3; ++ch) frame[i * 3 + ch] = static_cast<float>(to_u8_clipped(frame[i * 3 + ch]));
-  }
-  if (!filters_identity(vp)) {
-    const float preset_sharpen = preset_sharpen_amount(vp.pop_filter);
-#pragma unroll 1
-    for (int32_t i = first; i < n; i += stride) {
-      preset_pixel_op(vp.pop_filter, frame + i * 3, i / vp.W, i % vp.W, vp.H, vp.W);
-      if (preset_sharpen == 0.0f) chain_head_pixel(vp, fs.jitter, frame + i * 3);
-    }
-    if (preset_sharpen > 0.0f) {
-      pass.sharpen(preset_sharpen);
-#pragma unroll 1
-      for (int32_t i = first; i < n; i += stride) chain_head_pixel(vp, fs.jitter, frame + i * 3);
-    }
-    if (vp.blur_sigma > 0.0f) pass.blur(vp.blur_sigma);
-    if (vp.sharpen_amount > 0.0f) pass.sharpen(vp.sharpen_amount);
-    if (vp.pixelate_factor > 1) pass.pixelate(vp.pixelate_factor);
-#pragma unroll 1
-    for (int32_t i = first; i < n; i += stride) chain_tail_pixel(vp, fs.keys, i / vp.W, i % vp.W, frame + i * 3);
-  }
+  walk_filters(vp, fs.episode_preset, fs.jitter, fs.keys, pass);
   // Truncate and light the owned pixels into registers, then stage the bytes over the frame.
   uint32_t px[kFramePassPixelsPerThread];
 #pragma unroll

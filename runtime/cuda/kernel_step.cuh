@@ -1,13 +1,12 @@
 // Parameters and stepping of the CUDA kernels (kernels.cuh): a config type's parameters as device
-// constants (specialized) or __constant__ memory (DynamicCfg), and one environment's step with
-// automatic reset, as CpuBatch::step. Compiles under nvcc and NVRTC (no host headers).
+// constants (specialized) or __constant__ memory (DynamicCfg), and the outputs of one environment's
+// step for the episode driver (runtime/episode.h). Compiles under nvcc and NVRTC (no host headers).
 #pragma once
 
 #include "runtime/cuda/device_envs.h"
+#include "runtime/episode.h"
 #include "runtime/kage_hd.h"
-#include "runtime/latent/latent_step.h"
 #include "runtime/rng.h"
-#include "runtime/visual/visual_update.h"
 
 namespace kage {
 
@@ -20,9 +19,10 @@ __device__ constexpr LatentParams kLatentOf = Cfg::latent();
 template <class Cfg>
 __device__ constexpr VisualParams kVisualOf = Cfg::visual();
 
-/// The parameters a kernel reads, as references.
+/// The parameters a kernel reads, as references (a parameter provider of runtime/episode.h).
 template <class Cfg>
 struct ParamsOf {
+  static constexpr bool kVisual = true;
   static __device__ __forceinline__ const LatentParams& latent() { return kLatentOf<Cfg>; }
   static __device__ __forceinline__ const VisualParams& visual() { return kVisualOf<Cfg>; }
 };
@@ -48,6 +48,7 @@ constexpr bool kGenericBuild<DynamicCfg> = true;
 
 template <>
 struct ParamsOf<DynamicCfg> {
+  static constexpr bool kVisual = true;
   static __device__ __forceinline__ const LatentParams& latent() { return kage_dynamic_latent; }
   static __device__ __forceinline__ const VisualParams& visual() { return kage_dynamic_visual; }
 };
@@ -57,15 +58,6 @@ struct ParamsOf<DynamicCfg> {
 /// The episode key of environment `env` in episode `episode` (as CpuBatch::episode_key).
 __device__ __forceinline__ Key device_episode_key(const DeviceEnvs& e, int32_t env, uint32_t episode) {
   return fold(seed_key(e.seeds[env]), episode);
-}
-
-/// Starts `episode` of one environment: layout, latent and visual state (spec 4.2).
-__device__ __forceinline__ void device_reset_env(const LatentParams& lp, const VisualParams& vp, const AssetView& assets,
-                                          Key key, uint32_t episode, uint8_t* segments, LatentState& ls,
-                                          VisualState& vs) {
-  latent_reset(lp, key, episode, segments, ls);
-  const LayoutView layout{segments};
-  visual_reset(vp, assets, key, [&](int32_t c) { return ground_top(lp, layout, c); }, vs);
 }
 
 /// Writes reward, flags and info of one step (or zeros after an explicit reset).
@@ -97,24 +89,30 @@ __device__ __forceinline__ int32_t load_action(const ActionSource& a, int32_t en
   return static_cast<int32_t>(v);
 }
 
-/// One step of one environment with same-step automatic reset (the order of HostBatch::step): the
-/// latent step and its outcome; then the visual step of the new t; if the episode ended, its last
-/// state goes to the final_* buffers (the render kernel draws it) and the next episode starts.
-__device__ __forceinline__ void device_step_env(const LatentParams& lp, const VisualParams& vp, const DeviceEnvs& e,
-                                                int32_t env, uint8_t* segments, LatentState& ls, VisualState& vs) {
-  const StepOutcome o = latent_step(lp, LayoutView{segments}, ls, load_action(e.actions, env));
-  record_outcome(e, env, ls, o);
-  visual_step(vp, e.assets, device_episode_key(e, env, ls.episode), static_cast<uint32_t>(ls.t), ls.vx, vs);
-  const bool done = o.terminated || o.truncated;
-  e.final_mask[env] = done ? 1 : 0;
-  if (!done) return;
-  e.final_latent[env] = ls;
-  copy_words(e.final_segments + static_cast<int64_t>(env) * e.segment_stride, segments, e.segment_stride);
-  copy_words(e.final_visual + env, &vs, e.visual_extent);
-  copy_info_row(e.final_info, e.info, env);
-  const uint32_t next = ls.episode + 1;
-  device_reset_env(lp, vp, e.assets, device_episode_key(e, env, next), next, segments, ls, vs);
-  record_info(e.info, env, ls, StepOutcome{});
-}
+/// Where the episode driver puts one environment's step: reward, flags and info in the batch's
+/// columns; a finished episode's last state goes to the final_* buffers (the render kernel draws it)
+/// before the next episode starts, which then reports its spawn point's info.
+struct DeviceStepOut {
+  const DeviceEnvs& e;
+  int32_t env;
+
+  __device__ __forceinline__ Key episode_key(uint32_t episode) const { return device_episode_key(e, env, episode); }
+  __device__ __forceinline__ void record(const LatentState& ls, const StepOutcome& o) const {
+    record_outcome(e, env, ls, o);
+  }
+  __device__ __forceinline__ bool stepped(bool done, const uint8_t* segments, const LatentState& ls,
+                                          const VisualState* vs) const {
+    e.final_mask[env] = done ? 1 : 0;
+    if (!done) return false;
+    e.final_latent[env] = ls;
+    copy_words(e.final_segments + static_cast<int64_t>(env) * e.segment_stride, segments, e.segment_stride);
+    copy_words(e.final_visual + env, vs, e.visual_extent);
+    copy_info_row(e.final_info, e.info, env);
+    return true;
+  }
+  __device__ __forceinline__ void restarted(const uint8_t*, const LatentState& ls, const VisualState*) const {
+    record_info(e.info, env, ls, StepOutcome{});
+  }
+};
 
 }  // namespace kage

@@ -24,8 +24,8 @@ namespace kage {
 /// thread, the column table from the layout at `segments`, then the pixels. Entered by every thread of
 /// the group; the state in `sh` must be complete. `frame` is the float frame of the frame-pass path.
 template <class Cfg, class Group, class Slot>
-__device__ __forceinline__ void render_frame(const DeviceEnvs& e, int32_t env, Slot& sh, const uint8_t* segments,
-                                             float* frame, uint8_t* out) {
+__device__ __forceinline__ void group_render_frame(const DeviceEnvs& e, int32_t env, Slot& sh, const uint8_t* segments,
+                                                   float* frame, uint8_t* out) {
   const LatentParams& lp = ParamsOf<Cfg>::latent();
   const VisualParams& vp = ParamsOf<Cfg>::visual();
   if (Group::rank() == 0) {
@@ -111,8 +111,8 @@ __device__ __forceinline__ void reset_body(const DeviceEnvs& e) {
   e.final_mask[env] = 0;
   if (e.reset_mask && !e.reset_mask[env]) return;
   LatentState ls;
-  device_reset_env(ParamsOf<Cfg>::latent(), ParamsOf<Cfg>::visual(), e.assets, device_episode_key(e, env, 0), 0,
-            e.segments + static_cast<int64_t>(env) * e.segment_stride, ls, e.visual[env]);
+  episode_reset(ParamsOf<Cfg>{}, e.assets, device_episode_key(e, env, 0), 0,
+                e.segments + static_cast<int64_t>(env) * e.segment_stride, ls, &e.visual[env]);
   e.latent[env] = ls;
   record_outcome(e, env, ls, StepOutcome{});
 }
@@ -124,8 +124,11 @@ __device__ __forceinline__ void step_body(const DeviceEnvs& e) {
   const int32_t env = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
   if (env >= e.num_envs) return;
   LatentState ls = e.latent[env];
-  device_step_env(ParamsOf<Cfg>::latent(), ParamsOf<Cfg>::visual(), e, env,
-           e.segments + static_cast<int64_t>(env) * e.segment_stride, ls, e.visual[env]);
+  // Both addresses before the action's load, the order the PTX had before the episode driver.
+  uint8_t* segments = e.segments + static_cast<int64_t>(env) * e.segment_stride;
+  VisualState* vs = &e.visual[env];
+  DeviceStepOut out{e, env};
+  episode_step(ParamsOf<Cfg>{}, e.assets, load_action(e.actions, env), segments, ls, vs, out);
   e.latent[env] = ls;
 }
 
@@ -142,7 +145,7 @@ __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh
     group_copy_words<BlockGroup>(&sh.latent, e.latent + env, static_cast<int32_t>(sizeof(LatentState)));
     group_copy_words<BlockGroup>(&sh.visual, e.visual + env, e.visual_extent);
     __syncthreads();
-    render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
+    group_render_frame<Cfg, BlockGroup>(e, env, sh, e.segments + static_cast<int64_t>(env) * e.segment_stride, frame,
                                   frame_of<Cfg>(e.obs, env));
     __syncthreads();
     if (e.final_mask[env]) {
@@ -150,7 +153,7 @@ __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh
       group_copy_words<BlockGroup>(&sh.latent, e.final_latent + env, static_cast<int32_t>(sizeof(LatentState)));
       group_copy_words<BlockGroup>(&sh.visual, e.final_visual + env, e.visual_extent);
       __syncthreads();
-      render_frame<Cfg, BlockGroup>(e, env, sh, e.final_segments + static_cast<int64_t>(env) * e.segment_stride,
+      group_render_frame<Cfg, BlockGroup>(e, env, sh, e.final_segments + static_cast<int64_t>(env) * e.segment_stride,
                                     frame, frame_of<Cfg>(e.final_obs, env));
       __syncthreads();
     }
@@ -160,7 +163,7 @@ __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh
 /// Uniform random actions in [0, 8) for step t (benchmarks), from their own key.
 __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n, uint64_t seed, uint32_t t) {
   const int32_t i = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
-  if (i < n) actions[i] = randint(fold(seed_key(seed), t), static_cast<uint32_t>(i), 0, 8);
+  if (i < n) actions[i] = benchmark_action(seed, t, static_cast<uint32_t>(i));
 }
 
 }  // namespace kage

@@ -48,24 +48,41 @@ __device__ __forceinline__ void group_copy_words(void* dst, const void* src, int
   for (int32_t i = Group::rank(); i < bytes / 4; i += Group::size()) d[i] = s[i];
 }
 
-/// Per-pixel stages of the register path after composition: the episode preset (7.1 A), the main chain
-/// without neighbourhood passes (B), the point lights (8.2); the same arithmetic as render_frame.
+/// The register path's frame for walk_filters: one pixel, in registers. Without neighbourhood passes
+/// (the path is chosen only when needs_frame_passes is false).
+struct PixelFrame {
+  static constexpr bool kPasses = false;
+  uint8_t* rgb;
+  int32_t r, c;
+  float f[3];
+  bool loaded = false;  ///< f holds the current values (else rgb does)
+
+  template <class Fn>
+  __device__ __forceinline__ void pixels(const Fn& fn) {
+    if (!loaded)
+      for (int32_t ch = 0; ch < 3; ++ch) f[ch] = static_cast<float>(rgb[ch]);
+    loaded = true;
+    fn(f, r, c);
+  }
+  template <class Fn>
+  __device__ __forceinline__ void last_pixels(const Fn& fn) {
+    pixels(fn);
+    truncate();
+  }
+  __device__ __forceinline__ void truncate() {
+    for (int32_t ch = 0; ch < 3; ++ch) rgb[ch] = to_u8_clipped(f[ch]);
+    loaded = false;
+  }
+};
+
+/// Per-pixel stages of the register path after composition: the filter chain (walk_filters), then the
+/// point lights (8.2); the same arithmetic as render_frame.
 template <class Cfg>
 __device__ __forceinline__ void pixel_stages(const VisualState& vs, const FrameSetup& fs, int32_t r, int32_t c,
                                              uint8_t* rgb) {
   const VisualParams& vp = ParamsOf<Cfg>::visual();
-  if (fs.episode_preset != Preset::kNone) {
-    float f[3] = {static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2])};
-    preset_pixel_op(fs.episode_preset, f, r, c, vp.H, vp.W);
-    for (int32_t ch = 0; ch < 3; ++ch) rgb[ch] = to_u8_clipped(f[ch]);
-  }
-  if (!filters_identity(vp)) {
-    float f[3] = {static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2])};
-    preset_pixel_op(vp.pop_filter, f, r, c, vp.H, vp.W);
-    chain_head_pixel(vp, fs.jitter, f);
-    chain_tail_pixel(vp, fs.keys, r, c, f);
-    for (int32_t ch = 0; ch < 3; ++ch) rgb[ch] = to_u8_clipped(f[ch]);
-  }
+  PixelFrame frame{rgb, r, c};
+  walk_filters(vp, fs.episode_preset, fs.jitter, fs.keys, frame);
   if (vp.point_light_enabled) light_pixel(vp, vs, r, c, rgb);
 }
 

@@ -4,7 +4,7 @@
 
 #include "runtime/kage_hd.h"
 #include "runtime/kage_math.h"
-#include "runtime/visual/gpu_div.h"
+#include "runtime/visual/approx_division.h"
 #include "runtime/visual/visual_math.h"
 #include "runtime/visual/visual_params.h"
 
@@ -27,20 +27,20 @@ KAGE_HD void gamma_op(float* f, float g) {
 
 /// 7.2: one HSV round trip with saturation multiplier `sat` and hue offset `hue_shift` (degrees);
 /// the later hue rules override the earlier ones, so saturation 0 gives max(R, G, B) greys (11.42).
-/// The divisions by dl and mx are the GPU's approximate ones (gpu_div.h): with correctly rounded
+/// The divisions by dl and mx are the GPU's approximate ones (approx_division.h): with correctly rounded
 /// divisions 1-5 % of the values of a saturation or hue change end 1 code off the goldens; with the
 /// original's compiled arithmetic (no FMA contraction anywhere in this op, checked against XLA's output
-/// on an H200) the goldens are reproduced. kInv255 is gpu_rcp(255).
+/// on an H200) the goldens are reproduced. kInv255 is approx_rcp(255).
 KAGE_HD void hsv_op(float* f, float sat, float hue_shift) {
   const float r = f[0] * kInv255, g = f[1] * kInv255, b = f[2] * kInv255;
   const float mx = maxf(maxf(r, g), b);
   const float mn = minf(minf(r, g), b);
   const float dl = mx - mn;
   float hue = 0.0f;
-  if (mx == r && dl > 0.0f) hue = 60.0f * floor_mod(gpu_div(g - b, dl), 6.0f);
-  if (mx == g && dl > 0.0f) hue = 60.0f * (gpu_div(b - r, dl) + 2.0f);
-  if (mx == b && dl > 0.0f) hue = 60.0f * (gpu_div(r - g, dl) + 4.0f);
-  float s = mx > 0.0f ? gpu_div(dl, mx) : 0.0f;
+  if (mx == r && dl > 0.0f) hue = 60.0f * floor_mod(approx_div(g - b, dl), 6.0f);
+  if (mx == g && dl > 0.0f) hue = 60.0f * (approx_div(b - r, dl) + 2.0f);
+  if (mx == b && dl > 0.0f) hue = 60.0f * (approx_div(r - g, dl) + 4.0f);
+  float s = mx > 0.0f ? approx_div(dl, mx) : 0.0f;
   const float v = mx;
   if (sat != 1.0f) s = clampf(s * sat, 0.0f, 1.0f);
   if (hue_shift != 0.0f) hue = floor_mod(hue + hue_shift, 360.0f);

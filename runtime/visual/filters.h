@@ -1,5 +1,7 @@
 // The filter chain (spec 7.1): the per-episode preset, then the main chain, as per-pixel head and tail
-// stages around the neighbourhood passes. Stochastic stages draw from the frame's FilterNoise key.
+// stages around the neighbourhood passes. The order of the stages is written once, in walk_filters;
+// each renderer (apply_filters here, the GPU's frame-pass and register paths) walks it over its own
+// frame. Stochastic stages draw from the frame's FilterNoise key.
 #pragma once
 
 #include "runtime/kage_hd.h"
@@ -83,66 +85,107 @@ KAGE_HD void chain_tail_pixel(const VisualParams& p, const FilterKeys& keys, int
   }
 }
 
-/// The output of a pass becomes the input of the next.
-KAGE_HD void swap_buffers(float*& a, float*& b) {
-  float* t = a;
-  a = b;
-  b = t;
-}
-
-/// Sequential driver of the whole chain over a uint8 frame `img` (H x W x 3), in place. `f` and `tmp`
-/// are caller-provided float buffers of H*W*3 values each (no heap in semantics code).
-KAGE_HD void apply_filters(const VisualParams& p, Preset episode, const FilterKeys& keys, uint8_t* img, float* f,
-                           float* tmp) {
-  const int32_t H = p.H, W = p.W, n = H * W;
+/// The filter stages in spec 7.1 order over a renderer's frame, which runs them:
+///   frame.pixels(fn)        fn(float* rgb, int32_t r, int32_t c) at every pixel; the first call of a
+///                           group loads the frame's uint8 values
+///   frame.last_pixels(fn)   the same for the final per-pixel stage; the frame's values are final after it
+///   frame.truncate()        rounds the values to uint8 and back (7.1 A's truncation)
+///   frame.sharpen(amount), frame.blur(sigma), frame.pixelate(factor)   the neighbourhood passes
+/// Frame::kPasses is false for a frame that never takes them (the GPU's register path: chosen only
+/// when needs_frame_passes is false), so their calls are not even compiled there.
+template <class Frame>
+KAGE_HD void walk_filters(const VisualParams& p, Preset episode, const float* jitter_m, const FilterKeys& keys,
+                          Frame& frame) {
   // A: the per-episode preset, truncated back to uint8 (7.1 A, 11.41).
   if (episode != Preset::kNone) {
-    for (int32_t i = 0; i < n; ++i) {
-      float* px = f + i * 3;
-      for (int32_t ch = 0; ch < 3; ++ch) px[ch] = static_cast<float>(img[i * 3 + ch]);
-      preset_pixel_op(episode, px, i / W, i % W, H, W);
+    frame.pixels([&](float* px, int32_t r, int32_t c) { preset_pixel_op(episode, px, r, c, p.H, p.W); });
+    if constexpr (Frame::kPasses) {
+      const float sharpen = preset_sharpen_amount(episode);
+      if (sharpen > 0.0f) frame.sharpen(sharpen);
     }
-    const float sharpen = preset_sharpen_amount(episode);
-    if (sharpen > 0.0f) {
-      sharpen_pass(f, tmp, H, W, sharpen);
-      swap_buffers(f, tmp);
-    }
-    for (int32_t i = 0; i < n * 3; ++i) img[i] = to_u8_clipped(f[i]);
+    frame.truncate();
   }
   if (filters_identity(p)) return;
-  // B: the main chain.
+  // B: the main chain. The pop_filter preset's sharpen sits between its pixel stages and step 2.
+  float preset_sharpen = 0.0f;
+  if constexpr (Frame::kPasses) preset_sharpen = preset_sharpen_amount(p.pop_filter);
+  frame.pixels([&](float* px, int32_t r, int32_t c) {
+    preset_pixel_op(p.pop_filter, px, r, c, p.H, p.W);
+    if (preset_sharpen == 0.0f) chain_head_pixel(p, jitter_m, px);
+  });
+  if constexpr (Frame::kPasses) {
+    if (preset_sharpen > 0.0f) {
+      frame.sharpen(preset_sharpen);
+      frame.pixels([&](float* px, int32_t, int32_t) { chain_head_pixel(p, jitter_m, px); });
+    }
+    if (p.blur_sigma > 0.0f) frame.blur(p.blur_sigma);
+    if (p.sharpen_amount > 0.0f) frame.sharpen(p.sharpen_amount);
+    if (p.pixelate_factor > 1) frame.pixelate(p.pixelate_factor);
+  }
+  frame.last_pixels([&](float* px, int32_t r, int32_t c) { chain_tail_pixel(p, keys, r, c, px); });
+}
+
+/// The CPU's frame for walk_filters: a uint8 image (H x W x 3) and two float buffers of H*W*3 values,
+/// each pass writing the other one.
+struct CpuFilterFrame {
+  static constexpr bool kPasses = true;
+  int32_t H, W;
+  uint8_t* img;
+  float* f;
+  float* tmp;
+  bool loaded = false;  ///< f holds the current values (else img does)
+
+  template <class Fn>
+  KAGE_HD void pixels(const Fn& fn) {
+    for (int32_t i = 0; i < H * W; ++i) {
+      float* px = f + i * 3;
+      if (!loaded)
+        for (int32_t ch = 0; ch < 3; ++ch) px[ch] = static_cast<float>(img[i * 3 + ch]);
+      fn(px, i / W, i % W);
+    }
+    loaded = true;
+  }
+  template <class Fn>
+  KAGE_HD void last_pixels(const Fn& fn) {
+    for (int32_t i = 0; i < H * W; ++i) {
+      float* px = f + i * 3;
+      fn(px, i / W, i % W);
+      for (int32_t ch = 0; ch < 3; ++ch) img[i * 3 + ch] = to_u8_clipped(px[ch]);
+    }
+    loaded = false;
+  }
+  KAGE_HD void truncate() {
+    for (int32_t i = 0; i < H * W * 3; ++i) img[i] = to_u8_clipped(f[i]);
+    loaded = false;
+  }
+  KAGE_HD void sharpen(float amount) {
+    sharpen_pass(f, tmp, H, W, amount);
+    swap();
+  }
+  KAGE_HD void blur(float sigma) {
+    blur_pass(f, tmp, H, W, sigma);
+    swap();
+  }
+  KAGE_HD void pixelate(int32_t factor) {
+    pixelate_pass(f, tmp, H, W, factor);
+    swap();
+  }
+  /// The output of a pass becomes the input of the next.
+  KAGE_HD void swap() {
+    float* t = f;
+    f = tmp;
+    tmp = t;
+  }
+};
+
+/// The whole chain over a uint8 frame `img` (H x W x 3), in place. `f` and `tmp` are caller-provided
+/// float buffers of H*W*3 values each (no heap in semantics code).
+KAGE_HD void apply_filters(const VisualParams& p, Preset episode, const FilterKeys& keys, uint8_t* img, float* f,
+                           float* tmp) {
   float jitter_m[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   if (p.color_jitter_std > 0.0f) jitter_matrix(keys.jitter, p.color_jitter_std, jitter_m);
-  const float preset_sharpen = preset_sharpen_amount(p.pop_filter);
-  for (int32_t i = 0; i < n; ++i) {
-    float* px = f + i * 3;
-    for (int32_t ch = 0; ch < 3; ++ch) px[ch] = static_cast<float>(img[i * 3 + ch]);
-    preset_pixel_op(p.pop_filter, px, i / W, i % W, H, W);
-    if (preset_sharpen == 0.0f) chain_head_pixel(p, jitter_m, px);
-  }
-  if (preset_sharpen > 0.0f) {
-    // The pop_filter preset's sharpen sits between its pixel stages and step 2.
-    sharpen_pass(f, tmp, H, W, preset_sharpen);
-    swap_buffers(f, tmp);
-    for (int32_t i = 0; i < n; ++i) chain_head_pixel(p, jitter_m, f + i * 3);
-  }
-  if (p.blur_sigma > 0.0f) {
-    blur_pass(f, tmp, H, W, p.blur_sigma);
-    swap_buffers(f, tmp);
-  }
-  if (p.sharpen_amount > 0.0f) {
-    sharpen_pass(f, tmp, H, W, p.sharpen_amount);
-    swap_buffers(f, tmp);
-  }
-  if (p.pixelate_factor > 1) {
-    pixelate_pass(f, tmp, H, W, p.pixelate_factor);
-    swap_buffers(f, tmp);
-  }
-  for (int32_t i = 0; i < n; ++i) {
-    float* px = f + i * 3;
-    chain_tail_pixel(p, keys, i / W, i % W, px);
-    for (int32_t ch = 0; ch < 3; ++ch) img[i * 3 + ch] = to_u8_clipped(px[ch]);
-  }
+  CpuFilterFrame frame{p.H, p.W, img, f, tmp};
+  walk_filters(p, episode, jitter_m, keys, frame);
 }
 
 }  // namespace kage

@@ -17,7 +17,8 @@ namespace kage {
 KAGE_HD int32_t render_scratch_floats(const VisualParams& p) { return 2 * p.H * p.W * 3; }
 
 /// Renders the observation of step t (0 = reset) of the episode with key `episode` into `out`
-/// (H x W x 3 uint8, row-major). `solid(r, wc)` answers the layout mask at row r and world column wc,
+/// (H x W x 3 uint8, row-major), one pixel after the other (the GPU's group_render_frame in
+/// runtime/cuda/kernels.cuh draws the same frame with the threads of a block). `solid(r, wc)` answers the layout mask at row r and world column wc,
 /// clamping both (spec 6.3). `scratch` holds render_scratch_floats(p) floats; it is only touched when
 /// a filter is active.
 template <class SolidFn>

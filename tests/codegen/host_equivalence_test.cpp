@@ -11,7 +11,7 @@
 
 #include "compiler/codegen.h"
 #include "compiler/environment.h"
-#include "runtime/host/host_batch.h"
+#include "runtime/cpu/host_batch.h"
 #include "tests/codegen/host_registry.h"
 
 namespace {

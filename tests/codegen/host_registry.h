@@ -4,7 +4,7 @@
 #include <map>
 #include <string>
 
-#include "runtime/host/specialized_env.h"
+#include "runtime/cpu/specialized_env.h"
 
 namespace kage::test {
 

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "compiler/commands.h"
-#include "runtime/host/image_io.h"
+#include "runtime/io/image_io.h"
 #include "tests/integration/integration_support.h"
 
 namespace {

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "runtime/host/asset_pack.h"
-#include "runtime/host/asset_scan.h"
-#include "runtime/host/image_io.h"
+#include "runtime/io/asset_pack.h"
+#include "runtime/io/asset_scan.h"
+#include "runtime/io/image_io.h"
 #include "tests/skip.h"
 
 namespace {

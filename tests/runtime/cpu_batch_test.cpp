@@ -5,7 +5,7 @@
 #include <cstring>
 #include <vector>
 
-#include "runtime/host/cpu_batch.h"
+#include "runtime/cpu/cpu_batch.h"
 #include "runtime/latent/latent_step.h"
 #include "tests/runtime/latent_test_params.h"
 

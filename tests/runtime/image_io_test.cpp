@@ -1,4 +1,4 @@
-// Tests for runtime/host image I/O: decoding errors, PNG round trip, the GIF
+// Tests for runtime/io image I/O: decoding errors, PNG round trip, the GIF
 // encoder (decoded back with stb_image) and the Lanczos resampler.
 #include <catch2/catch.hpp>
 #include <stb/stb_image.h>
@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "runtime/host/gif_writer.h"
-#include "runtime/host/image_io.h"
+#include "runtime/io/gif_writer.h"
+#include "runtime/io/image_io.h"
 
 namespace {
 

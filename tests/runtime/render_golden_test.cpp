@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "runtime/host/asset_pack.h"
-#include "runtime/host/image_io.h"
+#include "runtime/io/asset_pack.h"
+#include "runtime/io/image_io.h"
 #include "runtime/visual/image_diff.h"
 #include "runtime/visual/render.h"
 

@@ -1,5 +1,5 @@
 // Golden replay and comparison for `kagec golden check`.
-#include "runtime/host/golden_check.h"
+#include "verify/golden/golden_check.h"
 
 #include <algorithm>
 #include <cmath>

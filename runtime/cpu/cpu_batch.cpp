@@ -1,11 +1,11 @@
 // CPU batch runtime: static partition of the environments over std::threads; every environment is
 // independent, so the results are the same for any thread count.
-#include "runtime/host/cpu_batch.h"
+#include "runtime/cpu/cpu_batch.h"
 
 #include <algorithm>
 #include <thread>
 
-#include "runtime/latent/latent_step.h"
+#include "runtime/episode.h"
 
 namespace kage {
 
@@ -41,11 +41,43 @@ void CpuBatch::parallel_for(const Fn& fn) {
   for (std::thread& w : workers) w.join();
 }
 
+namespace {
+
+/// The episode driver's outputs for the hidden game: info rows, and the render hook on each step, before
+/// an automatic reset (on_final) and after it (on_reset).
+struct LatentStepOut {
+  const LatentParams& p;
+  const RenderHook& hook;
+  BatchInfo& info;
+  Key seed;  ///< seed_key of the environment's seed
+  int32_t env;
+  bool autoreset;
+  uint8_t* obs;
+
+  Key episode_key(uint32_t episode) const { return fold(seed, episode); }
+  void record(const LatentState& s, const StepOutcome& o) const { info.record(env, s, o); }
+  bool stepped(bool done, const uint8_t* segments, const LatentState& s, const VisualState*) const {
+    const LayoutView layout{segments};
+    if (autoreset && done) {
+      if (hook.on_final) hook.on_final(hook.user, env, episode_key(s.episode), p, layout, s);
+      return true;
+    }
+    if (hook.on_step) hook.on_step(hook.user, env, episode_key(s.episode), p, layout, s, obs);
+    return false;
+  }
+  void restarted(const uint8_t* segments, const LatentState& s, const VisualState*) const {
+    if (hook.on_reset) hook.on_reset(hook.user, env, episode_key(s.episode), p, LayoutView{segments}, s, obs);
+  }
+};
+
+}  // namespace
+
 void CpuBatch::reset_env(int32_t env, uint32_t episode) {
-  const Key key = fold(seed_key(seeds_[env]), episode);
+  const LatentStepOut out{params_, hook_, info_, seed_key(seeds_[env]), env, options_.autoreset, obs(env)};
   uint8_t* segments = segments_.data() + static_cast<size_t>(env) * stride_;
-  latent_reset(params_, key, episode, segments, states_[env]);
-  if (hook_.on_reset) hook_.on_reset(hook_.user, env, key, params_, LayoutView{segments}, states_[env], obs(env));
+  episode_reset(LatentOnlyParams{&params_}, AssetView{}, out.episode_key(episode), episode, segments, states_[env],
+                nullptr);
+  out.restarted(segments, states_[env], nullptr);
 }
 
 void CpuBatch::reset(const uint64_t* seeds) {
@@ -62,15 +94,9 @@ void CpuBatch::reset(const uint64_t* seeds) {
 void CpuBatch::step(const int32_t* actions) {
   parallel_for([&](int32_t first, int32_t last) {
     for (int32_t env = first; env < last; ++env) {
-      const LayoutView layout = this->layout(env);
-      const StepOutcome o = latent_step(params_, layout, states_[env], actions[env]);
-      info_.record(env, states_[env], o);
-      if (options_.autoreset && (o.terminated || o.truncated)) {
-        if (hook_.on_final) hook_.on_final(hook_.user, env, episode_key(env), params_, layout, states_[env]);
-        reset_env(env, states_[env].episode + 1);
-      } else if (hook_.on_step) {
-        hook_.on_step(hook_.user, env, episode_key(env), params_, layout, states_[env], obs(env));
-      }
+      LatentStepOut out{params_, hook_, info_, seed_key(seeds_[env]), env, options_.autoreset, obs(env)};
+      episode_step(LatentOnlyParams{&params_}, AssetView{}, actions[env],
+                   segments_.data() + static_cast<size_t>(env) * stride_, states_[env], nullptr, out);
     }
   });
 }

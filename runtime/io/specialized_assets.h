@@ -1,5 +1,6 @@
 // The asset pack blob of a compiled config dir (assets.bin): the loaded background stack and sprite
-// sets, so a compiled config runs without the original image files. Little-endian, versioned.
+// sets, so a compiled config runs without the original image files. Versioned; numbers are written
+// in the writing machine's byte order (memcpy), so the blob is read back on machines of that order.
 #pragma once
 
 #include <cstdint>
@@ -9,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "runtime/host/asset_pack.h"
+#include "runtime/io/asset_pack.h"
 
 namespace kage {
 

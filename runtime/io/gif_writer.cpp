@@ -1,6 +1,6 @@
 // GIF89a writer: global 256-entry colour table, NETSCAPE2.0 looping extension,
 // one graphic control extension + image descriptor + LZW data per frame.
-#include "runtime/host/gif_writer.h"
+#include "runtime/io/gif_writer.h"
 
 #include <fmt/format.h>
 

@@ -1,11 +1,12 @@
-// CPU episode driver: the two HostKernels and the batch (threads, autoreset, final frames, saved state).
-#include "runtime/host/host_batch.h"
+// CPU batch: the two HostKernels and the batch (threads, explicit reset, saved state); the episode
+// driver (runtime/episode.h) steps each environment.
+#include "runtime/cpu/host_batch.h"
 
 #include <algorithm>
 #include <cstring>
 #include <thread>
 
-#include "runtime/host/batch_state.h"
+#include "runtime/cpu/batch_state.h"
 
 namespace kage {
 namespace {
@@ -16,14 +17,15 @@ class GenericHostKernels final : public HostKernels {
   const LatentParams& latent() const override { return latent_; }
   const VisualParams& visual() const override { return visual_; }
   void reset_env(const AssetView& a, Key k, uint32_t episode, const EnvSlot& e) const override {
-    env_reset(latent_, visual_, a, k, episode, e);
+    env_reset(params(), a, k, episode, e);
   }
-  StepOutcome step_env(const AssetView& a, Key k, int32_t action, const EnvSlot& e) const override {
-    return env_step(latent_, visual_, a, k, action, true, e);
+  void step_env(const AssetView& a, Key seed, int32_t action, const EnvSlot& e, const StepRows& rows) const override {
+    env_step(params(), a, seed, action, e, rows);
   }
-  void render_env(const AssetView& a, Key k, const EnvSlot& e) const override { env_render(latent_, visual_, a, k, e); }
+  void render_env(const AssetView& a, Key k, const EnvSlot& e) const override { env_render(params(), a, k, e); }
 
  private:
+  RuntimeParams params() const { return {&latent_, &visual_}; }
   LatentParams latent_;
   VisualParams visual_;
 };
@@ -36,10 +38,8 @@ class GeneratedHostKernels final : public HostKernels {
   void reset_env(const AssetView& a, Key k, uint32_t episode, const EnvSlot& e) const override {
     ep_.reset_env(&a, k, episode, &e);
   }
-  StepOutcome step_env(const AssetView& a, Key k, int32_t action, const EnvSlot& e) const override {
-    StepOutcome o{};
-    ep_.step_env(&a, k, action, 1, &e, &o);
-    return o;
+  void step_env(const AssetView& a, Key seed, int32_t action, const EnvSlot& e, const StepRows& rows) const override {
+    ep_.step_env(&a, seed, action, &e, &rows);
   }
   void render_env(const AssetView& a, Key k, const EnvSlot& e) const override { ep_.render_env(&a, k, &e); }
 
@@ -60,8 +60,12 @@ std::unique_ptr<HostKernels> generated_host_kernels(const HostEntryPoints& entry
 }
 
 HostBatch::HostBatch(std::unique_ptr<HostKernels> kernels, const AssetView& assets, int32_t num_envs,
-                     int32_t num_threads)
-    : kernels_(std::move(kernels)), assets_(assets), n_(num_envs), threads_(std::max(1, num_threads)) {
+                     int32_t num_threads, bool info_shows_new_episode)
+    : kernels_(std::move(kernels)),
+      assets_(assets),
+      n_(num_envs),
+      threads_(std::max(1, num_threads)),
+      info_shows_new_episode_(info_shows_new_episode) {
   seg_bytes_ = static_cast<size_t>(layout_segment_count(kernels_->latent()));
   frame_ = static_cast<size_t>(kernels_->visual().H) * kernels_->visual().W * 3;
   const size_t n = static_cast<size_t>(n_);
@@ -108,18 +112,13 @@ void HostBatch::reset(const uint64_t* seeds, const uint8_t* mask) {
 }
 
 void HostBatch::step(const int32_t* actions) {
-  const InfoArrays info = info_.columns();
-  const InfoArrays final_info = final_info_.columns();
+  StepRows rows{0, info_.reward.data(), info_.terminated.data(), info_.truncated.data(), info_.columns(),
+                final_mask_.data(), final_info_.columns(), nullptr, info_shows_new_episode_ ? 1 : 0};
   parallel_for([&](int32_t env, float* scratch) {
-    const StepOutcome o = kernels_->step_env(assets_, episode_key(env), actions[env], slot(env, scratch));
-    info_.record(env, latent_[env], o);
-    final_mask_[env] = (o.terminated || o.truncated) ? 1 : 0;
-    if (!final_mask_[env]) return;
-    // Same-step autoreset (spec 10.2): keep the finished episode's frame and info, then start the next.
-    std::memcpy(final_obs_.data() + env * frame_, obs_.data() + env * frame_, frame_);
-    copy_info_row(final_info, info, env);
-    reset_env(env, latent_[env].episode + 1, scratch);
-    record_info(info, env, latent_[env], StepOutcome{});
+    StepRows row = rows;
+    row.env = env;
+    row.final_obs = final_obs_.data() + env * frame_;
+    kernels_->step_env(assets_, seed_key(seeds_[env]), actions[env], slot(env, scratch), row);
   });
 }
 
@@ -137,7 +136,7 @@ std::vector<uint8_t> HostBatch::save_state(const std::string& spec_hash) const {
   put(l.terminated, info_.terminated.data(), n);
   put(l.truncated, info_.truncated.data(), n);
   int i = 0;
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) put(l.info[i++], info_.member.data(), n * sizeof(ctype));
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) put(l.info[i++], info_.member.data(), n * sizeof(ctype));
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
   return out;
@@ -157,7 +156,7 @@ std::string HostBatch::load_state(const uint8_t* data, size_t size, const std::s
   get(info_.terminated.data(), l.terminated, n);
   get(info_.truncated.data(), l.truncated, n);
   int i = 0;
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) get(info_.member.data(), l.info[i++], n * sizeof(ctype));
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) get(info_.member.data(), l.info[i++], n * sizeof(ctype));
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
   // Frames are a pure function of the state: render them again instead of saving them.

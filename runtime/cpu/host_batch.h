@@ -1,4 +1,4 @@
-// The CPU episode driver of the public API: N environments of one configuration stepped through a
+// The CPU batch of the public API: N environments of one configuration stepped through a
 // HostKernels (a generated kernels_host.so, or the generic path over run-time parameters) and split over
 // threads, with same-step automatic reset that keeps the finished episode's final frame and info.
 #pragma once
@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "runtime/host/cpu_batch.h"
-#include "runtime/host/specialized_env.h"
+#include "runtime/cpu/cpu_batch.h"
+#include "runtime/cpu/specialized_env.h"
 
 namespace kage {
 
@@ -21,8 +21,10 @@ class HostKernels {
   virtual const VisualParams& visual() const = 0;
   /// Starts `episode` (key `episode_key`) and renders its first frame into e.obs.
   virtual void reset_env(const AssetView& assets, Key episode_key, uint32_t episode, const EnvSlot& e) const = 0;
-  /// One step; renders the new state into e.obs.
-  virtual StepOutcome step_env(const AssetView& assets, Key episode_key, int32_t action, const EnvSlot& e) const = 0;
+  /// One step through the episode driver (`seed`: seed_key of the environment's seed) into `rows`:
+  /// renders the new state into e.obs and, when the episode ends, starts the next one.
+  virtual void step_env(const AssetView& assets, Key seed, int32_t action, const EnvSlot& e,
+                        const StepRows& rows) const = 0;
   /// Renders the current state into e.obs.
   virtual void render_env(const AssetView& assets, Key episode_key, const EnvSlot& e) const = 0;
 };
@@ -35,19 +37,21 @@ std::unique_ptr<HostKernels> generated_host_kernels(const HostEntryPoints& entry
 class HostBatch {
  public:
   /// `assets` must outlive the batch; `num_envs` and `num_threads` > 0. Results do not depend on the
-  /// thread count.
-  HostBatch(std::unique_ptr<HostKernels> kernels, const AssetView& assets, int32_t num_envs, int32_t num_threads);
+  /// thread count. `info_shows_new_episode`: after an automatic reset, info() shows the new episode's
+  /// spawn point (else the finished step's; final_info() has that either way).
+  HostBatch(std::unique_ptr<HostKernels> kernels, const AssetView& assets, int32_t num_envs, int32_t num_threads,
+            bool info_shows_new_episode = true);
 
   /// Starts episode 0 of the environments with mask[env] != 0 (every one when `mask` is null) with the
   /// new seeds[env]; the others keep their state and outputs. No environment is final afterwards.
   void reset(const uint64_t* seeds, const uint8_t* mask);
   /// One action per environment, actions[env] (any int32: spec 3.2 masks them). An environment whose
   /// episode ends is final: its last frame and info go to final_observations() and final_info(), and
-  /// it starts its next episode at once (observations() and info() show the new episode; reward and
-  /// flags stay the finishing step's).
+  /// it starts its next episode at once (observations() show the new episode, and so does info()
+  /// when info_shows_new_episode; reward and flags stay the finishing step's).
   void step(const int32_t* actions);
 
-  /// The saved state (runtime/host/batch_state.h) under `spec_hash`.
+  /// The saved state (runtime/cpu/batch_state.h) under `spec_hash`.
   std::vector<uint8_t> save_state(const std::string& spec_hash) const;
   /// Restores a saved state and renders its observations; the reason when it cannot, else empty.
   std::string load_state(const uint8_t* data, size_t size, const std::string& spec_hash);
@@ -68,6 +72,8 @@ class HostBatch {
   const InfoTable& final_info() const { return final_info_; }
   const LatentState& latent_state(int32_t env) const { return latent_[env]; }
   const VisualState& visual_state(int32_t env) const { return visual_[env]; }
+  /// The layout of environment `env` (layout_segment_count bytes).
+  const uint8_t* segments(int32_t env) const { return segments_.data() + env * seg_bytes_; }
   Key episode_key(int32_t env) const { return fold(seed_key(seeds_[env]), latent_[env].episode); }
 
  private:
@@ -83,6 +89,7 @@ class HostBatch {
   AssetView assets_;
   int32_t n_;
   int32_t threads_;
+  bool info_shows_new_episode_;
   size_t seg_bytes_;
   size_t frame_;
   std::vector<uint64_t> seeds_;

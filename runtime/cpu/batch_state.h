@@ -51,7 +51,7 @@ struct BatchStateLayout {
     terminated = take(n);
     truncated = take(n);
     int i = 0;
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) info[i++] = take(n * sizeof(ctype));
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) info[i++] = take(n * sizeof(ctype));
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
     total = at;

@@ -29,7 +29,7 @@ KAGE_HD float fused_mul_add(float a, float b, float c) {
 
 /// The GPU's approximate reciprocal rcp.approx.f32(y), modelled as described above. Zero, denormal and
 /// huge |y| (where div.full rescales its operands) fall back to the correctly rounded 1/y.
-KAGE_HD float gpu_rcp(float y) {
+KAGE_HD float approx_rcp(float y) {
   // e(m) in ulps of the result: c0 + c1 x + c2 x^2 + c3 x^3 with x in [-0.5, 0.5) across each segment
   // of 2^16 mantissas.
   static constexpr float kErr[128][4] = {
@@ -185,6 +185,6 @@ KAGE_HD float gpu_rcp(float y) {
 }
 
 /// a / b as the original's GPU computes a division by a computed value (PTX div.full.f32).
-KAGE_HD float gpu_div(float a, float b) { return a * gpu_rcp(b); }
+KAGE_HD float approx_div(float a, float b) { return a * approx_rcp(b); }
 
 }  // namespace kage

@@ -1,6 +1,6 @@
 // Builds an AssetPack from ordered source lists, following the original
 // environment constructor's loading rules (spec 2.4).
-#include "runtime/host/asset_pack.h"
+#include "runtime/io/asset_pack.h"
 
 #include <fmt/format.h>
 
@@ -8,8 +8,8 @@
 #include <cmath>
 #include <filesystem>
 
-#include "runtime/host/asset_scan.h"
-#include "runtime/host/image_io.h"
+#include "runtime/io/asset_scan.h"
+#include "runtime/io/image_io.h"
 
 namespace kage {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/host/image_io.h"
+#include "runtime/io/image_io.h"
 
 namespace kage {
 

@@ -37,13 +37,13 @@ struct CpuBatchOptions {
 
 /// The info columns of runtime/info_fields.def for N environments (structure of arrays).
 struct InfoTable {
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) std::vector<ctype> member;
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) std::vector<ctype> member;
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
 
   /// Sizes every column for n environments, zeroed.
   void resize(size_t n) {
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) member.assign(n, ctype{});
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) member.assign(n, ctype{});
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
   }
@@ -51,7 +51,7 @@ struct InfoTable {
   /// The columns as pointers (valid until the next resize).
   InfoArrays columns() {
     InfoArrays a;
-#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc) a.member = member.data();
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) a.member = member.data();
 #include "runtime/info_fields.def"
 #undef KAGE_INFO_FIELD
     return a;
