@@ -1,0 +1,256 @@
+"""The baseline's convolutions for K packed runs as Triton implicit-GEMM kernels (--triton-conv): the run is a
+grid axis instead of a channel group, so each layer and pass is one launch over all K runs, and the patches
+are never materialised (cuDNN runs grouped convolutions group by group with slicing copies; im2col + bmm
+moved more bytes than it saved: bench/results/2026-11-23-h100-packed-training-speed.md). Activations are
+[K, B, H, W, C] (NHWC per run); the parameters keep nn.Conv2d(groups=K)'s layout, so checkpoints are the
+same. Imported only under --triton-conv: triton is a GPU-machine dependency. Checked and timed by
+bench/triton_conv_check.py.
+"""
+from typing import Optional
+
+import torch
+import triton
+import triton.language as tl
+
+# Channel counts are 48/128/64 in (after space-to-depth) and 32/64/64 out; a program's output tile covers
+# the whole output width (BLOCK_N) in the forward pass and the weight gradient, so the configs tune the rest.
+_FORWARD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_K": k}, num_warps=w, num_stages=s)
+                    for m, k, w, s in ((128, 32, 4, 3), (128, 64, 4, 3), (64, 32, 4, 4), (128, 64, 8, 4))]
+_DGRAD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_N": n, "BLOCK_K": k}, num_warps=w, num_stages=s)
+                  for m, n, k, w, s in ((128, 64, 32, 4, 3), (128, 128, 32, 8, 3), (64, 64, 64, 4, 4),
+                                        (128, 64, 64, 8, 3))]
+_WGRAD_CONFIGS = [triton.Config({"BLOCK_D": d, "BLOCK_M": m}, num_warps=w, num_stages=s)
+                  for d, m, w, s in ((64, 64, 4, 3), (128, 64, 4, 3), (64, 128, 4, 4), (128, 128, 8, 3))]
+_SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW"]
+
+
+@triton.autotune(configs=_FORWARD_CONFIGS, key=_SHAPE_KEY)
+@triton.jit
+def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
+                    H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
+                    CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                    BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
+    """y[run, m, co] = bias + sum over (kh, kw, ci) of x[run, b, oh + kh, ow + kw, ci] * w[run, kh, kw, ci, co],
+    m = (b, oh, ow). For one kh the (kw, ci) pairs are KW * CIN contiguous input elements (NHWC), so the
+    reduction walks kh and BLOCK_K-wide pieces of that span: contiguous, coalesced loads."""
+    STEPS: tl.constexpr = (KW * CIN + BLOCK_K - 1) // BLOCK_K
+    run = tl.program_id(2).to(tl.int64)
+    rows = tl.program_id(0) * BLOCK_M + tl.arange(0, BLOCK_M)
+    cols = tl.program_id(1) * BLOCK_N + tl.arange(0, BLOCK_N)
+    row_ok = rows < B * (OH * OW)
+    col_ok = cols < COUT
+    b = rows // (OH * OW)
+    oh = rows // OW % OH
+    ow = rows % OW
+    x_row = ((b * H + oh) * W + ow).to(tl.int64) * CIN  # the top-left tap of each output position
+    x_run = x_ptr + (run * B) * (H * W * CIN)
+    w_run = w_ptr + run * (KH * KW * CIN * COUT)
+    acc = tl.zeros((BLOCK_M, BLOCK_N), dtype=tl.float32)
+    for step in range(0, KH * STEPS):
+        kh = step // STEPS
+        span = step % STEPS * BLOCK_K + tl.arange(0, BLOCK_K)
+        span_ok = span < KW * CIN
+        patch = tl.load(x_run + (x_row[:, None] + (kh * (W * CIN) + span)[None, :]),
+                        mask=row_ok[:, None] & span_ok[None, :], other=0.0)
+        weight = tl.load(w_run + ((kh * (KW * CIN) + span)[:, None] * COUT + cols[None, :]),
+                         mask=span_ok[:, None] & col_ok[None, :], other=0.0)
+        acc += tl.dot(patch, weight)
+    acc += tl.load(bias_ptr + run * COUT + cols, mask=col_ok, other=0.0)[None, :]
+    y_run = y_ptr + (run * B) * (OH * OW * COUT)
+    tl.store(y_run + (rows.to(tl.int64)[:, None] * COUT + cols[None, :]), acc.to(y_ptr.dtype.element_ty),
+             mask=row_ok[:, None] & col_ok[None, :])
+
+
+@triton.autotune(configs=_DGRAD_CONFIGS, key=_SHAPE_KEY)
+@triton.jit
+def dgrad_kernel(dy_ptr, w_ptr, dx_ptr, B,
+                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
+                  CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                  BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
+    """Stride 1: dx[run, b, ih, iw, ci] = sum over (kh, kw, co) of dy[run, b, ih - kh, iw - kw, co] *
+    w[run, kh, kw, ci, co], the taps whose output position falls outside OH x OW masked off."""
+    STEPS: tl.constexpr = (COUT + BLOCK_K - 1) // BLOCK_K
+    run = tl.program_id(2).to(tl.int64)
+    rows = tl.program_id(0) * BLOCK_M + tl.arange(0, BLOCK_M)
+    cols = tl.program_id(1) * BLOCK_N + tl.arange(0, BLOCK_N)
+    row_ok = rows < B * (H * W)
+    col_ok = cols < CIN
+    b = rows // (H * W)
+    ih = rows // W % H
+    iw = rows % W
+    # dy's offset of (b, ih, iw) as if that output position existed; tap (kh, kw) reads kh * OW + kw
+    # positions before it, wherever the mask allows.
+    dy_row = ((b * OH + ih) * OW + iw).to(tl.int64) * COUT
+    dy_run = dy_ptr + (run * B) * (OH * OW * COUT)
+    w_run = w_ptr + run * (KH * KW * CIN * COUT)
+    acc = tl.zeros((BLOCK_M, BLOCK_N), dtype=tl.float32)
+    for step in range(0, KH * KW * STEPS):
+        tap = step // STEPS
+        kh = tap // KW
+        kw = tap % KW
+        chans = step % STEPS * BLOCK_K + tl.arange(0, BLOCK_K)
+        chan_ok = chans < COUT
+        tap_ok = row_ok & (ih >= kh) & (ih - kh < OH) & (iw >= kw) & (iw - kw < OW)
+        grad = tl.load(dy_run + (dy_row[:, None] + (chans - (kh * OW + kw) * COUT)[None, :]),
+                       mask=tap_ok[:, None] & chan_ok[None, :], other=0.0)
+        weight = tl.load(w_run + ((tap * CIN + cols)[None, :] * COUT + chans[:, None]),
+                         mask=chan_ok[:, None] & col_ok[None, :], other=0.0)
+        acc += tl.dot(grad, weight)
+    dx_run = dx_ptr + (run * B) * (H * W * CIN)
+    tl.store(dx_run + (rows.to(tl.int64)[:, None] * CIN + cols[None, :]), acc.to(dx_ptr.dtype.element_ty),
+             mask=row_ok[:, None] & col_ok[None, :])
+
+
+@triton.autotune(configs=_WGRAD_CONFIGS, key=_SHAPE_KEY)
+@triton.jit
+def wgrad_kernel(x_ptr, dy_ptr, parts_ptr, B, CHUNK, SPLIT,
+                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
+                  CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                  BLOCK_D: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_M: tl.constexpr):
+    """parts[run, part, kh, kw, ci, co] = sum over m in the part's CHUNK rows of x[run, b, oh + kh, ow + kw, ci]
+    * dy[run, m, co]. A program owns BLOCK_D contiguous (kw, ci) pairs of one kh (axis 0), BLOCK_N output
+    channels (axis 1) and one (run, part) (axis 2): SPLIT parts per run spread M's up to 2 M rows over the GPU,
+    each writing fp32 partial sums that the caller adds up."""
+    STEPS: tl.constexpr = (KW * CIN + BLOCK_D - 1) // BLOCK_D
+    kh = tl.program_id(0) // STEPS
+    span = tl.program_id(0) % STEPS * BLOCK_D + tl.arange(0, BLOCK_D)
+    span_ok = span < KW * CIN
+    cols = tl.program_id(1) * BLOCK_N + tl.arange(0, BLOCK_N)
+    col_ok = cols < COUT
+    run = (tl.program_id(2) // SPLIT).to(tl.int64)
+    part = tl.program_id(2) % SPLIT
+    m_total = B * (OH * OW)
+    start = part * CHUNK
+    end = tl.minimum(start + CHUNK, m_total)
+    x_run = x_ptr + (run * B) * (H * W * CIN) + kh * (W * CIN)
+    dy_run = dy_ptr + (run * B) * (OH * OW * COUT)
+    acc = tl.zeros((BLOCK_D, BLOCK_N), dtype=tl.float32)
+    for m0 in range(start, end, BLOCK_M):
+        rows = m0 + tl.arange(0, BLOCK_M)
+        row_ok = rows < end
+        b = rows // (OH * OW)
+        oh = rows // OW % OH
+        ow = rows % OW
+        x_row = ((b * H + oh) * W + ow).to(tl.int64) * CIN
+        patch = tl.load(x_run + (x_row[:, None] + span[None, :]), mask=row_ok[:, None] & span_ok[None, :],
+                        other=0.0)
+        grad = tl.load(dy_run + (rows.to(tl.int64)[:, None] * COUT + cols[None, :]),
+                       mask=row_ok[:, None] & col_ok[None, :], other=0.0)
+        acc += tl.dot(tl.trans(patch), grad)
+    parts_run = parts_ptr + tl.program_id(2).to(tl.int64) * (KH * KW * CIN * COUT)
+    tl.store(parts_run + ((kh * (KW * CIN) + span)[:, None] * COUT + cols[None, :]), acc,
+             mask=span_ok[:, None] & col_ok[None, :])
+
+
+def _width_block(channels: int) -> int:
+    """A tile width covering up to 64 channels (tl.dot needs at least 16)."""
+    return max(16, min(64, triton.next_power_of_2(channels)))
+
+
+def _wgrad_chunk(m: int, runs: int) -> int:
+    """Rows of M each weight-gradient program sums: about 512 (run, part) programs in all fill the GPU, and at
+    least 2,048 rows each keep the fp32 partial sums small against the work."""
+    return max(2048, triton.cdiv(triton.cdiv(m, max(1, 512 // runs)), 128) * 128)
+
+
+def _shape_args(h: int, w: int, kh: int, kw: int, cin: int, cout: int) -> dict:
+    return dict(H=h, W=w, OH=h - kh + 1, OW=w - kw + 1, CIN=cin, COUT=cout, KH=kh, KW=kw)
+
+
+def _forward(x: torch.Tensor, w: torch.Tensor, bias: torch.Tensor) -> torch.Tensor:
+    """x [K, B, H, W, Cin], w [K, kh, kw, Cin, Cout] (x's dtype), bias [K * Cout] fp32 -> [K, B, OH, OW, Cout]."""
+    k, b, h, wd, cin = x.shape
+    _, kh, kw, _, cout = w.shape
+    shape = _shape_args(h, wd, kh, kw, cin, cout)
+    y = torch.empty((k, b, shape["OH"], shape["OW"], cout), device=x.device, dtype=x.dtype)
+    block_n = _width_block(cout)
+    grid = lambda meta: (triton.cdiv(b * shape["OH"] * shape["OW"], meta["BLOCK_M"]), triton.cdiv(cout, block_n), k)
+    forward_kernel[grid](x, w, bias, y, b, **shape, BLOCK_N=block_n)
+    return y
+
+
+def _dgrad(dy: torch.Tensor, w: torch.Tensor, h: int, wd: int) -> torch.Tensor:
+    """dy [K, B, OH, OW, Cout], w [K, kh, kw, Cin, Cout] (dy's dtype) -> dx [K, B, H, W, Cin]."""
+    k, b, _, _, cout = dy.shape
+    _, kh, kw, cin, _ = w.shape
+    dx = torch.empty((k, b, h, wd, cin), device=dy.device, dtype=dy.dtype)
+    grid = lambda meta: (triton.cdiv(b * h * wd, meta["BLOCK_M"]), triton.cdiv(cin, meta["BLOCK_N"]), k)
+    dgrad_kernel[grid](dy, w, dx, b, **_shape_args(h, wd, kh, kw, cin, cout))
+    return dx
+
+
+def _wgrad(x: torch.Tensor, dy: torch.Tensor, kh: int, kw: int) -> torch.Tensor:
+    """x [K, B, H, W, Cin], dy [K, B, OH, OW, Cout] (same dtype) -> dw [K, kh, kw, Cin, Cout] in fp32."""
+    k, b, h, wd, cin = x.shape
+    _, _, oh, ow, cout = dy.shape
+    chunk = _wgrad_chunk(b * oh * ow, k)
+    split = triton.cdiv(b * oh * ow, chunk)
+    parts = torch.empty((k, split, kh, kw, cin, cout), device=x.device, dtype=torch.float32)
+    block_n = _width_block(cout)
+    grid = lambda meta: (kh * triton.cdiv(kw * cin, meta["BLOCK_D"]), triton.cdiv(cout, block_n), k * split)
+    wgrad_kernel[grid](x, dy, parts, b, chunk, split, **_shape_args(h, wd, kh, kw, cin, cout), BLOCK_N=block_n)
+    return parts.sum(dim=1)
+
+
+class _PackedConvStride1(torch.autograd.Function):
+    """The stride-1, unpadded packed convolution: x [K, B, H, W, Cin] (bf16 or fp32), the grouped layout's weight
+    [K * Cout, Cin, kh, kw] and bias [K * Cout] (any float dtype) -> [K, B, OH, OW, Cout] in x's dtype. The
+    kernels compute in x's dtype with fp32 sums (fp32 master weights arrive as they are under autocast: cast
+    here); the gradients come back in their inputs' dtypes."""
+
+    @staticmethod
+    def forward(ctx, x, weight, bias):
+        k, cin = x.shape[0], x.shape[-1]
+        cout, kh, kw = weight.shape[0] // k, weight.shape[2], weight.shape[3]
+        assert weight.shape[1] == cin and weight.shape[0] == k * cout, (x.shape, weight.shape)
+        x = x.contiguous()
+        w = weight.reshape(k, cout, cin, kh, kw).permute(0, 3, 4, 2, 1).contiguous().to(x.dtype)
+        ctx.save_for_backward(x, w)
+        ctx.weight_dtype, ctx.bias_dtype = weight.dtype, bias.dtype
+        return _forward(x, w, bias.to(torch.float32).contiguous())
+
+    @staticmethod
+    def backward(ctx, dy):
+        x, w = ctx.saved_tensors
+        k, _, h, wd, cin = x.shape
+        _, kh, kw, _, cout = w.shape
+        dy = dy.to(x.dtype).contiguous()
+        dx = _dgrad(dy, w, h, wd) if ctx.needs_input_grad[0] else None  # frames need none
+        dw = db = None
+        if ctx.needs_input_grad[1]:
+            dw = _wgrad(x, dy, kh, kw).permute(0, 4, 3, 1, 2).reshape(k * cout, cin, kh, kw).to(ctx.weight_dtype)
+        if ctx.needs_input_grad[2]:
+            db = dy.sum(dim=(1, 2, 3), dtype=torch.float32).reshape(-1).to(ctx.bias_dtype)
+        return dx, dw, db
+
+
+def space_to_depth(x: torch.Tensor, s: int, dtype: Optional[torch.dtype] = None) -> torch.Tensor:
+    """[K, B, H, W, C] -> [K, B, H // s, W // s, C * s * s], channel (c, p, q) of block (i, j) holding
+    x[.., s * i + p, s * j + q, c] (the trainer's fused-input order); rows and columns past the last whole
+    block are dropped (a stride-s convolution whose kernel is a multiple of s never reads them). A dtype
+    converts in the same copy (uint8 frames)."""
+    k, b, h, w, c = x.shape
+    h, w = h // s * s, w // s * s
+    blocks = x[:, :, :h, :w].reshape(k, b, h // s, s, w // s, s, c).permute(0, 1, 2, 4, 6, 3, 5)
+    if dtype is not None:
+        blocks = blocks.to(dtype, memory_format=torch.contiguous_format)
+    return blocks.reshape(k, b, h // s, w // s, c * s * s)
+
+
+def weight_space_to_depth(weight: torch.Tensor, s: int) -> torch.Tensor:
+    """The grouped layout's weight [K * Cout, C, kh, kw] -> [K * Cout, C * s * s, kh // s, kw // s] for
+    space_to_depth's input: filter row s * a + p, column s * b + q meets channel (c, p, q) at offset (a, b)."""
+    o, c, kh, kw = weight.shape
+    assert kh % s == 0 and kw % s == 0, (weight.shape, s)
+    blocks = weight.reshape(o, c, kh // s, s, kw // s, s).permute(0, 1, 3, 5, 2, 4)
+    return blocks.reshape(o, c * s * s, kh // s, kw // s)
+
+
+def packed_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int = 1) -> torch.Tensor:
+    """K runs' unpadded convolutions at once: x [K, B, H, W, Cin], weight [K * Cout, Cin, kh, kw] and bias
+    [K * Cout] as nn.Conv2d(groups=K) holds them -> [K, B, OH, OW, Cout]. A stride s > 1 (kernel a multiple of
+    s) becomes the equal stride-1 convolution of s x s blocks (space_to_depth), which the kernels run."""
+    if stride != 1:
+        x, weight = space_to_depth(x, stride), weight_space_to_depth(weight, stride)
+    return _PackedConvStride1.apply(x, weight, bias)
+
