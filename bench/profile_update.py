@@ -11,16 +11,19 @@ import torch
 
 from kage.agent import Agent
 
-VARIANTS = [  # (bf16, channels_last, fused_input)
-    (False, False, False), (False, False, True), (True, False, True), (True, True, False), (True, True, True)]
+VARIANTS = [  # (bf16, channels_last, fused_input, triton_conv)
+    (False, False, False, False), (False, False, True, False), (True, False, True, False), (True, True, False, False),
+    (True, True, True, False), (True, False, True, True)]
 
 
-def minibatch_ms(k: int, minibatch: int, bf16: bool, channels_last: bool, fused: bool, profile: bool) -> float:
+def minibatch_ms(k: int, minibatch: int, bf16: bool, channels_last: bool, fused: bool, triton_conv: bool,
+                 profile: bool) -> float:
     agent = Agent(list(range(k)), device="cuda")
     if channels_last:
         agent = agent.to(memory_format=torch.channels_last)
     agent.input_dtype = torch.bfloat16 if bf16 else torch.float32
     agent.space_to_depth = fused
+    agent.triton_conv = triton_conv
     optimizer = torch.optim.Adam(agent.parameters(), lr=5e-4, eps=1e-5)
     obs = torch.randint(0, 256, (k, minibatch, 128, 128, 3), dtype=torch.uint8, device="cuda")
 
@@ -60,13 +63,13 @@ def main() -> None:
     torch.backends.cudnn.benchmark = True
     torch.set_float32_matmul_precision("high")
     print(f"{torch.cuda.get_device_name()}, torch {torch.__version__}, K = {a.packs}, minibatch {a.minibatch}")
-    print("| bf16 | channels last | fused input | ms per minibatch | update-only steps/s |")
-    print("|---|---|---|---|---|")
-    for i, (bf16, cl, fused) in enumerate(VARIANTS):
-        ms = minibatch_ms(a.packs, a.minibatch, bf16, cl, fused, a.profile and i in (0, len(VARIANTS) - 1))
+    print("| bf16 | channels last | fused input | triton conv | ms per minibatch | update-only steps/s |")
+    print("|---|---|---|---|---|---|")
+    for i, (bf16, cl, fused, tri) in enumerate(VARIANTS):
+        ms = minibatch_ms(a.packs, a.minibatch, bf16, cl, fused, tri, a.profile and i in (0, len(VARIANTS) - 1))
         torch.cuda.empty_cache()
         # An iteration is 24 minibatches of 2,048 per run: steps/s = K * 16,384 / (24 * ms).
-        print(f"| {bf16} | {cl} | {fused} | {ms:.1f} | {a.packs * 16384 / (24 * ms / 1e3):,.0f} |", flush=True)
+        print(f"| {bf16} | {cl} | {fused} | {tri} | {ms:.1f} | {a.packs * 16384 / (24 * ms / 1e3):,.0f} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -44,6 +44,7 @@ class Agent(nn.Module):
         self.critic_bias = nn.Parameter(torch.zeros(k, 1, 1, device=device))
         self.input_dtype = torch.float32  # bfloat16 under --bf16
         self.space_to_depth = False  # --fused-input
+        self.triton_conv = False  # --triton-conv (kage.triton_conv; with --fused-input)
         with torch.no_grad():
             for run, seed in enumerate(seeds):
                 self._initialise(run, seed, channels)
@@ -63,15 +64,19 @@ class Agent(nn.Module):
 
     def forward(self, obs: torch.Tensor):
         """uint8 [K, B, H, W, C] frames -> logits [K, B, A] and values [K, B]. The first operation is the
-        conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups."""
+        conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups (under --triton-conv
+        as a batch index)."""
         k, b, h, w, c = obs.shape
-        if self.space_to_depth:
-            x = F.relu(self._conv1_space_to_depth(obs))
+        if self.triton_conv:
+            x = self._torso_triton(obs)
         else:
-            x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
-        x = F.relu(self.conv2(x))
-        x = F.relu(self.conv3(x))
-        x = x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
+            if self.space_to_depth:
+                x = F.relu(self._conv1_space_to_depth(obs))
+            else:
+                x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
+            x = F.relu(self.conv2(x))
+            x = F.relu(self.conv3(x))
+            x = x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
         hidden = F.relu(torch.baddbmm(self.fc_bias, x, self.fc_weight))
         # The heads always in float32, even under --bf16: values reach thousands (an untrained episode
         # returns about -3,900), where bfloat16's spacing is 16, more than a step's reward; rounded values
@@ -106,6 +111,19 @@ class Agent(nn.Module):
         if self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
             weight = weight.contiguous(memory_format=torch.channels_last)
         return F.conv2d(x, weight, self.conv1.bias, stride=1, groups=k)
+
+    def _torso_triton(self, obs: torch.Tensor) -> torch.Tensor:
+        """The three convolutions on kage.triton_conv's kernels (--triton-conv): the runs as a batch index
+        instead of channel groups, activations [K, B, H, W, C], the same parameters; conv1 on the frames cut
+        into 4x4 blocks as under --fused-input. Returns [K, B, flat] in each run's (channel, row, column) order."""
+        from kage import triton_conv  # here, not at the top: triton is needed only under the flag
+        k, b = obs.shape[:2]
+        x = triton_conv.space_to_depth(obs, 4, self.input_dtype).div_(255.0)
+        x = F.relu(triton_conv.packed_conv(x, triton_conv.weight_space_to_depth(self.conv1.weight, 4),
+                                           self.conv1.bias))
+        x = F.relu(triton_conv.packed_conv(x, self.conv2.weight, self.conv2.bias, stride=2))
+        x = F.relu(triton_conv.packed_conv(x, self.conv3.weight, self.conv3.bias))
+        return x.permute(0, 1, 4, 2, 3).reshape(k, b, self.flat)
 
     def run_view(self, tensor: torch.Tensor) -> torch.Tensor:
         """A tensor shaped like a parameter (the parameter, its gradient, an Adam moment) as [K, ...]: the

@@ -111,6 +111,9 @@ class Args:
     cuda_graph: bool = field(default=False, metadata={"help": "replay the rollout's policy step as a CUDA graph"})
     fused_input: bool = field(default=False, metadata={
         "help": "one pass from uint8 frames to 4x4 blocks in the network's dtype; conv1 as the equal 2x2 conv"})
+    triton_conv: bool = field(default=False, metadata={
+        "help": "the convolutions as Triton implicit-GEMM kernels with the runs as a batch index, not cuDNN's "
+                "channel groups (needs --fused-input, CUDA and triton)"})
 
     @property
     def batch_size(self) -> int:
@@ -183,8 +186,13 @@ def validate(args: Args) -> List[str]:
         problems.append("--bf16 and --cuda-graph are for --device cuda")
     if args.video_every < 0:
         problems.append("--video-every must not be negative")
-    if args.agent != plugins.BASELINE_AGENT and (args.fused_input or args.channels_last):
-        problems.append("--fused-input and --channels-last rewrite the baseline's network: drop them with --agent")
+    if args.agent != plugins.BASELINE_AGENT and (args.fused_input or args.channels_last or args.triton_conv):
+        problems.append("--fused-input, --channels-last and --triton-conv rewrite the baseline's network: drop them "
+                        "with --agent")
+    if args.triton_conv and args.device == "cpu":
+        problems.append("--triton-conv is for --device cuda")
+    if args.triton_conv and not args.fused_input:
+        problems.append("--triton-conv runs conv1 on --fused-input's 4x4 blocks: add --fused-input")
     return problems
 
 
@@ -346,6 +354,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
         if args.bf16:
             agent.input_dtype = torch.bfloat16
         agent.space_to_depth = args.fused_input
+        agent.triton_conv = args.triton_conv
     augment = plugins.load_augment(args.augment)
     agent_spec = {"agent": args.agent, "observation_shape": [height, width, channels], "num_actions": num_actions,
                   "use_frame_stack": args.use_frame_stack}  # what kage.evaluate needs to rebuild a run's policy

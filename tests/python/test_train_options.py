@@ -35,6 +35,8 @@ def test_every_option_at_once(tmp_path):
 
 @pytest.mark.parametrize("flags, message", [
     (["--device", "cpu", "--bf16"], "--bf16 and --cuda-graph are for --device cuda"),
+    (["--device", "cpu", "--triton-conv", "--fused-input"], "--triton-conv is for --device cuda"),
+    (["--triton-conv"], "--triton-conv runs conv1 on --fused-input's 4x4 blocks: add --fused-input"),
     (["--num-minibatches", "3"], "must divide the batch"),
     (["--eval-config-paths", "a", "b", "--eval-config-labels", "x"], "gives 1 labels for 2 eval configs"),
     (["--total-timesteps", "10"], "less than one batch"),
