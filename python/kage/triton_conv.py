@@ -27,9 +27,9 @@ _SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW"]
 @triton.autotune(configs=_FORWARD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
 def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
-                    H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
-                    CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
-                    BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
+                   H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
+                   CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                   BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
     """y[run, m, co] = bias + sum over (kh, kw, ci) of x[run, b, oh + kh, ow + kw, ci] * w[run, kh, kw, ci, co],
     m = (b, oh, ow). For one kh the (kw, ci) pairs are KW * CIN contiguous input elements (NHWC), so the
     reduction walks kh and BLOCK_K-wide pieces of that span: contiguous, coalesced loads."""
@@ -64,9 +64,9 @@ def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
 @triton.autotune(configs=_DGRAD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
 def dgrad_kernel(dy_ptr, w_ptr, dx_ptr, B,
-                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
-                  CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
-                  BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
+                 H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
+                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                 BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
     """Stride 1: dx[run, b, ih, iw, ci] = sum over (kh, kw, co) of dy[run, b, ih - kh, iw - kw, co] *
     w[run, kh, kw, ci, co], the taps whose output position falls outside OH x OW masked off."""
     STEPS: tl.constexpr = (COUT + BLOCK_K - 1) // BLOCK_K
@@ -104,9 +104,9 @@ def dgrad_kernel(dy_ptr, w_ptr, dx_ptr, B,
 @triton.autotune(configs=_WGRAD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
 def wgrad_kernel(x_ptr, dy_ptr, parts_ptr, B, CHUNK, SPLIT,
-                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
-                  CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
-                  BLOCK_D: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_M: tl.constexpr):
+                 H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
+                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                 BLOCK_D: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_M: tl.constexpr):
     """parts[run, part, kh, kw, ci, co] = sum over m in the part's CHUNK rows of x[run, b, oh + kh, ow + kw, ci]
     * dy[run, m, co]. A program owns BLOCK_D contiguous (kw, ci) pairs of one kh (axis 0), BLOCK_N output
     channels (axis 1) and one (run, part) (axis 2): SPLIT parts per run spread M's up to 2 M rows over the GPU,
