@@ -30,6 +30,7 @@ the log. A run directory holds everything needed to resume a killed run exactly 
 import argparse
 import contextlib
 import dataclasses
+import importlib.util
 import json
 import math
 import os
@@ -193,6 +194,9 @@ def validate(args: Args) -> List[str]:
         problems.append("--triton-conv is for --device cuda")
     if args.triton_conv and not args.fused_input:
         problems.append("--triton-conv runs conv1 on --fused-input's 4x4 blocks: add --fused-input")
+    if args.triton_conv and importlib.util.find_spec("triton") is None:
+        problems.append("--triton-conv needs the triton package (it comes with PyTorch's CUDA builds): install it, "
+                        "or drop --triton-conv")
     return problems
 
 

@@ -33,6 +33,16 @@ def test_every_option_at_once(tmp_path):
     assert summary["evaluations"] == 3 and "diff/noisy/success_once" in summary["stats"]
 
 
+def test_triton_conv_without_triton(monkeypatch, capsys):
+    """Where triton is not installed (as on the CPU machines), --triton-conv is refused before training."""
+    real_find_spec = train.importlib.util.find_spec
+    monkeypatch.setattr(train.importlib.util, "find_spec",
+                        lambda name, *rest: None if name == "triton" else real_find_spec(name, *rest))
+    with pytest.raises(SystemExit):
+        train.parse_args(["--train-config-path", NEAR_GOAL, "--device", "cuda", "--fused-input", "--triton-conv"])
+    assert "--triton-conv needs the triton package" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("flags, message", [
     (["--device", "cpu", "--bf16"], "--bf16 and --cuda-graph are for --device cuda"),
     (["--device", "cpu", "--triton-conv", "--fused-input"], "--triton-conv is for --device cuda"),
