@@ -5,7 +5,8 @@
 // Usage: kage_gpu_bench GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] [--check-envs N]
 //                       [--nvrtc-root DIR] [--breakdown] [--skip-checks] [--check-only]
 // GENERIC_FATBIN is the bench build's dynamic.fatbin. Each DIR is a `kagec compile` output directory
-// (kernels.fatbin, kage_<hash>.cu, params.bin, assets.bin), named after its last path component;
+// (its manifest, kernels.fatbin, the generated source, params.bin, assets.bin, read and verified
+// through compiler/compiled_dir.h), named after its last path component;
 // --breakdown needs one named "hardest". With --nvrtc-root (the directory holding runtime/), the
 // generated source is also compiled with NVRTC, cold (empty cache) and warm (disk cache hit).
 // --check-only checks every DIR through the generic build against the CPU reference (observations
@@ -17,16 +18,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "bench/bench_checks.h"
 #include "bench/gpu_measure.h"
+#include "compiler/compiled_dir.h"
 #include "runtime/cuda/device_batch.h"
 #include "runtime/cuda/module_loader.h"
-#include "runtime/host/specialized_assets.h"
 
 namespace kage::bench {
 namespace {
@@ -49,14 +48,6 @@ struct Config : MeasureTarget {
   std::string name;
 };
 
-std::string read_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) die(path.string() + ": cannot read");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 CudaModule load(const std::string& path) {
   std::string error;
   std::optional<CudaModule> m = CudaModule::load_file(path, &error);
@@ -73,7 +64,7 @@ SpriteSetTable table_of(const std::vector<SpriteSet>& sets) {
 }
 
 /// One `kagec compile` directory: its parameters, assets (host copies) and generated source.
-struct CompiledDir {
+struct BenchDir {
   std::string name;
   std::filesystem::path dir;
   LatentParams lp{};
@@ -99,32 +90,31 @@ struct CompiledDir {
   }
 };
 
-CompiledDir read_compiled(const std::string& path) {
+BenchDir read_compiled(const std::string& path) {
   namespace fs = std::filesystem;
-  CompiledDir c;
-  c.dir = fs::path(path);
+  std::string error;
+  const std::optional<CompiledDir> compiled = open_compiled_dir(path, &error);
+  if (!compiled) die(error);
+  BenchDir c;
+  c.dir = compiled->dir;
   c.name = fs::absolute(c.dir).lexically_normal().filename().string();
   if (c.name.empty()) c.name = fs::absolute(c.dir).lexically_normal().parent_path().filename().string();
-  const std::string params = read_bytes(c.dir / "params.bin");
-  if (params.size() != sizeof(LatentParams) + sizeof(VisualParams)) die(path + "/params.bin: wrong size (recompile)");
-  std::memcpy(&c.lp, params.data(), sizeof(LatentParams));
-  std::memcpy(&c.vp, params.data() + sizeof(LatentParams), sizeof(VisualParams));
-  std::optional<AssetPack> pack = deserialize_asset_pack(read_bytes(c.dir / "assets.bin"));
-  if (!pack) die(path + "/assets.bin: not an asset blob");
+  if (!read_compiled_params(*compiled, &c.lp, &c.vp, &error)) die(error);
+  std::optional<AssetPack> pack = read_compiled_assets(*compiled, &error);
+  if (!pack) die(error);
   c.pack = std::move(*pack);
-  for (const fs::directory_entry& f : fs::directory_iterator(c.dir)) {
-    const std::string n = f.path().filename().string();
-    if (n.starts_with("kage_") && n.ends_with(".cu")) c.source_name = n;
+  // --check-only needs no source; the NVRTC pass checks for one.
+  if (std::optional<std::string> source = read_compiled_source(*compiled, &error)) {
+    c.source = std::move(*source);
+    c.source_name = compiled->source_name();
   }
-  if (c.source_name.empty()) return c;  // --check-only needs no source; the NVRTC pass checks for one
-  c.source = read_bytes(c.dir / c.source_name);
   return c;
 }
 
 using Clock = std::chrono::steady_clock;
 
 /// Seconds from `start` to the end of the first step of 1,024 environments of module `m`.
-double first_step_s(const CudaModule& m, const CompiledDir& c, Clock::time_point start) {
+double first_step_s(const CudaModule& m, const BenchDir& c, Clock::time_point start) {
   std::string error;
   std::optional<DeviceBatch> b = DeviceBatch::create(m, c.lp, c.vp, c.assets(), 1024, &error);
   if (!b) die(c.name + ": " + error);
@@ -173,12 +163,12 @@ std::vector<std::pair<std::string, VisualParams>> breakdown_variants(const Visua
 /// Every dir through the generic build: state identical, observations within 1 code (the generic
 /// build must match the CPU on every shipped config, not only on the two timed ones). Returns the
 /// exit status.
-int check_only(const CudaModule& dynamic, const std::vector<CompiledDir>& dirs, int32_t envs) {
+int check_only(const CudaModule& dynamic, const std::vector<BenchDir>& dirs, int32_t envs) {
   std::printf("## Generic build vs CPU reference, every config (%d envs, episode length + 5 steps)\n\n"
               "| config | episode length | steps | state mismatches | obs max diff | obs equal %% | result |\n"
               "|---|---|---|---|---|---|---|\n", envs);
   int32_t passed = 0;
-  for (const CompiledDir& c : dirs) {
+  for (const BenchDir& c : dirs) {
     const int32_t steps = c.lp.episode_length + 5;
     const CheckResult r = check_against_cpu(dynamic, c.lp, c.vp, c.assets(), envs, steps, 1);
     if (!r.error.empty()) {
@@ -230,7 +220,7 @@ int run(int argc, char** argv) {
     else die("unknown option " + a);
   }
   if (dirs.empty()) die("no --compiled DIR");
-  std::vector<CompiledDir> compiled;
+  std::vector<BenchDir> compiled;
   for (const std::string& d : dirs) compiled.push_back(read_compiled(d));
 
   std::string error;
@@ -249,14 +239,14 @@ int run(int argc, char** argv) {
               "| config | fatbin s | NVRTC cold s | NVRTC warm s (cache hit) |\n|---|---|---|---|\n");
   std::vector<CudaModule> modules;
   bool all_ok = true;
-  for (const CompiledDir& c : compiled) {
+  for (const BenchDir& c : compiled) {
     Clock::time_point t0 = Clock::now();
     modules.push_back(load((c.dir / "kernels.fatbin").string()));
     const double fatbin_s = first_step_s(modules.back(), c, t0);
     double times[2] = {0.0, 0.0};
     bool hits[2] = {false, false};
     for (int pass = 0; pass < 2 && !nvrtc_root.empty(); ++pass) {
-      if (c.source_name.empty()) die(c.dir.string() + ": no generated kage_*.cu");
+      if (c.source_name.empty()) die(c.dir.string() + ": its manifest names no generated source");
       const NvrtcOptions o{nvrtc_root, "bench-compiled-1", {}};
       t0 = Clock::now();
       std::optional<CudaModule> m = CudaModule::compile(c.source, c.source_name, o, &error, &hits[pass]);

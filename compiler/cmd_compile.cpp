@@ -3,17 +3,14 @@
 // Everything is built in a staging directory beside DIR that replaces DIR only when the compile
 // succeeded, so DIR never mixes the files of two compiles.
 #include <filesystem>
-#include <fstream>
 #include <ostream>
-#include <sstream>
 
 #include "compiler/build.h"
 #include "compiler/cli_common.h"
 #include "compiler/codegen.h"
 #include "compiler/compiled_dir.h"
 #include "compiler/file_out.h"
-#include "compiler/lower.h"
-#include "runtime/host/sha256.h"
+#include "compiler/load_lowered.h"
 #include "runtime/host/specialized_assets.h"
 
 namespace kage {
@@ -21,24 +18,6 @@ namespace kage {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string read_file(const fs::path& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-/// params.bin: the LatentParams words, then the VisualParams words (little-endian).
-std::string params_blob(const LoweredConfig& lowered) {
-  std::string out;
-  for (const auto& words : {param_words(lowered.latent), param_words(lowered.visual)}) {
-    for (uint32_t w : words) {
-      for (int b = 0; b < 4; ++b) out.push_back(static_cast<char>((w >> (8 * b)) & 0xffu));
-    }
-  }
-  return out;
-}
 
 /// The last lines of a tool's output, for a failure message.
 std::string tail(const std::string& s, size_t lines) {
@@ -62,15 +41,23 @@ int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
   app.add_flag("--no-host", no_host, "skip the host compiler (kernels_host.so)");
   opts.add_to(app, false);
   if (auto code = parse_args(app, args, io)) return *code;
-  int exit_code = kExitOk;
-  const auto spec = resolve_file("compile", file, opts, io, &exit_code);
-  if (!spec) return exit_code;
-  const LowerResult lowered = lower_spec(*spec);
-  if (!lowered.ok()) {
-    io.err << lowered.error_text() << "kagec compile: the runtime cannot hold this config\n";
+  SourceManager sources;
+  DiagEngine diags(sources);
+  if (!opts.apply(diags, io)) return kExitUsage;
+  DiskFileReader reader;
+  const LoweredFile loaded = load_lowered(file, opts.resolve_options(), sources, reader, diags);
+  print_text(diags, io.err, io.err_is_terminal);
+  if (!loaded.spec) {
+    io.err << "kagec compile: no Spec: fix the errors above\n";
     return kExitErrors;
   }
-  GeneratedSource gen = generate_source({spec->sha256(), lowered.config->latent, lowered.config->visual});
+  if (!loaded.ok()) {
+    io.err << loaded.lower_errors << "kagec compile: the runtime cannot hold this config\n";
+    return kExitErrors;
+  }
+  const Spec& spec = *loaded.spec;
+  const LoweredConfig& lowered = *loaded.config;
+  GeneratedSource gen = generate_source({spec.sha256(), lowered.latent, lowered.visual});
 
   if (!source_name.empty()) {
     if (const auto problem = source_name_problem(source_name)) {
@@ -103,19 +90,20 @@ int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
     io.err << "kagec compile: " << error << '\n';
     return false;
   };
-  if (!write(gen.file_name, gen.text) || !write("params.bin", params_blob(*lowered.config)) ||
-      !write("spec.json", spec->canonical_text()))
+  if (!write(gen.file_name, gen.text) ||
+      !write(kParamsFile, params_blob(param_words(lowered.latent), param_words(lowered.visual))) ||
+      !write(kSpecFile, spec.canonical_text()))
     return kExitErrors;
-  std::vector<std::string> files = {gen.file_name, "params.bin", "spec.json"};
+  std::vector<std::string> files = {gen.file_name, kParamsFile, kSpecFile};
   if (!no_build) {
-    AssetPackResult assets = load_asset_pack(lowered.config->assets);
+    AssetPackResult assets = load_asset_pack(lowered.assets);
     if (!assets.ok()) {
       io.err << "kagec compile: " << assets.error << '\n';
       return kExitErrors;
     }
     for (const std::string& w : assets.warnings) io.err << "kagec compile: warning: " << w << '\n';
-    if (!write("assets.bin", serialize_asset_pack(*assets.pack))) return kExitErrors;
-    files.push_back("assets.bin");
+    if (!write(kAssetsFile, serialize_asset_pack(*assets.pack))) return kExitErrors;
+    files.push_back(kAssetsFile);
   }
 
   Json builds = Json::object();
@@ -144,43 +132,30 @@ int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
     }
     builds[name] = b;
   };
-  build("gpu", "kernels.fatbin", no_gpu, nvcc, "nvcc not found ($CUDACXX, $CUDA_HOME/bin, /usr/local/cuda/bin, PATH)",
+  build("gpu", kFatbinFile, no_gpu, nvcc, "nvcc not found ($CUDACXX, $CUDA_HOME/bin, /usr/local/cuda/bin, PATH)",
         build_fatbin);
-  build("host", "kernels_host.so", no_host, cxx, "no host C++ compiler ($KAGE_HOST_CXX, $CXX, c++)",
+  build("host", kHostLibraryFile, no_host, cxx, "no host C++ compiler ($KAGE_HOST_CXX, $CXX, c++)",
         build_host_library);
 
-  Json file_list = Json::array();
-  for (const std::string& f : files) {
-    const std::string bytes = read_file(dir / f);
-    file_list.push_back({{"name", f}, {"bytes", bytes.size()}, {"sha256", sha256_hex(bytes)}});
-  }
   const std::string nvrtc = nvrtc_version();
-  const Json manifest = {
-      {"kagec_manifest", 1},
-      {"spec_sha256", spec->sha256()},
-      {"codegen_version", kCodegenVersion},
-      {"template_sha256", gen.template_hash},
-      {"latent_section_sha256", gen.latent_hash},
-      {"config_type", gen.config_name},
-      {"source", gen.file_name},
-      {"arch", kCudaArch},
-      {"params", {{"file", "params.bin"}, {"latent_bytes", sizeof(LatentParams)}, {"visual_offset", sizeof(LatentParams)},
-                  {"visual_bytes", sizeof(VisualParams)}}},
-      {"toolchain",
-       {{"nvcc", nvcc.empty() ? Json(nullptr) : Json(tool_version(nvcc))},
-        {"nvrtc", nvrtc.empty() ? Json(nullptr) : Json(nvrtc)},
-        {"host_cxx", cxx.empty() ? Json(nullptr) : Json(tool_version(cxx))}}},
-      {"flags", {{"nvcc", nvcc_flags()}, {"host", host_flags()}}},
-      {"builds", builds},
-      {"files", file_list},
-  };
+  ManifestRecord record{spec.sha256(), kCodegenVersion, gen.template_hash, gen.latent_hash, gen.config_name,
+                        gen.file_name, kCudaArch,
+                        {{"nvcc", nvcc.empty() ? Json(nullptr) : Json(tool_version(nvcc))},
+                         {"nvrtc", nvrtc.empty() ? Json(nullptr) : Json(nvrtc)},
+                         {"host_cxx", cxx.empty() ? Json(nullptr) : Json(tool_version(cxx))}},
+                        {{"nvcc", nvcc_flags()}, {"host", host_flags()}}, builds, files};
   bool failed = false;
   for (const auto& [name, b] : builds.items()) failed |= b.at("status") == "failed";
   if (failed) {
     io.err << "kagec compile: a build failed; '" << out_dir << "' is left as it was\n";
     return kExitErrors;
   }
-  if (!write(kManifestFile, json_file_text(manifest))) return kExitErrors;
+  const std::optional<std::string> manifest = manifest_text(dir, record, &error);
+  if (!manifest) {
+    io.err << "kagec compile: " << error << '\n';
+    return kExitErrors;
+  }
+  if (!write(kManifestFile, *manifest)) return kExitErrors;
   if (!publish_staging_dir(dir, out_dir, &error)) {
     io.err << "kagec compile: " << error << '\n';
     return kExitErrors;

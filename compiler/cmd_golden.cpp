@@ -7,7 +7,7 @@
 #include <unistd.h>
 
 #include "compiler/cli_common.h"
-#include "compiler/lower.h"
+#include "compiler/load_lowered.h"
 #include "runtime/host/golden_check.h"
 
 namespace kage {
@@ -44,23 +44,26 @@ struct GoldenContext {
 
   void fail(const std::string& name, const std::string& why) { lines.push_back(GoldenLine{name, "-", 0, "-", false, why}); }
 
-  /// The Spec of a config, or nothing (with the diagnostics added to the report).
-  std::optional<Spec> spec_of(const std::string& path, const std::optional<std::string>& root) {
+  /// A config through the front end and lowering; a failure is added to the report (under the file's
+  /// name for front-end errors, under `what` for lowering's).
+  LoweredFile load(const std::string& path, const std::optional<std::string>& root, const std::string& what) {
     SourceManager sources;
     DiagEngine diags(sources);
     DiskFileReader reader;
     ResolveOptions options;
     options.asset_root = root;
-    std::optional<Spec> spec = analyze_file(path, options, sources, reader, diags);
-    if (!spec || diags.has_errors()) {
+    LoweredFile loaded = load_lowered(path, options, sources, reader, diags);
+    if (!loaded.spec) {
       std::ostringstream text;
       print_text(diags, text);
       fail(path, "config has errors:\n" + text.str());
-      return std::nullopt;
+    } else if (!loaded.ok()) {
+      fail(what, loaded.lower_errors);
     }
-    return spec;
+    return loaded;
   }
 
+  /// A Spec edited after loading, lowered again; a failure is added to the report under `what`.
   std::optional<LoweredConfig> lowered(const Spec& spec, const std::string& what) {
     LowerResult r = lower_spec(spec);
     if (!r.ok()) fail(what, r.error_text());
@@ -83,7 +86,9 @@ struct GoldenContext {
     return root.string();
   }
 
-  std::optional<Spec> golden_default() { return spec_of((fs::path(configs) / "default.yaml").string(), std::nullopt); }
+  std::optional<Spec> golden_default() {
+    return load((fs::path(configs) / "default.yaml").string(), std::nullopt, "default").spec;
+  }
 };
 
 std::optional<json> read_json(GoldenContext& ctx, const fs::path& path) {
@@ -107,9 +112,8 @@ void check_physics_file(GoldenContext& ctx, const fs::path& file) {
   const std::optional<json> j = read_json(ctx, file);
   if (!j) return;
   const std::string config = j->value("config", "");
-  const std::optional<Spec> spec = ctx.spec_of((fs::path(ctx.configs) / (config + ".yaml")).string(), std::nullopt);
-  if (!spec) return;
-  const std::optional<LoweredConfig> low = ctx.lowered(*spec, config);
+  const LoweredFile loaded = ctx.load((fs::path(ctx.configs) / (config + ".yaml")).string(), std::nullopt, config);
+  const std::optional<LoweredConfig>& low = loaded.config;
   if (!low) return;
   for (GoldenLine& l : check_physics(file.filename().string(), low->latent, *j)) ctx.lines.push_back(std::move(l));
 }
@@ -122,9 +126,8 @@ void check_render_dir(GoldenContext& ctx, const fs::path& dir) {
   if (it == kRenderConfigs.end()) return ctx.fail(dir.string(), "no config is known for '" + config + "'");
   const std::optional<std::string> root = ctx.original_root();
   if (!root) return;
-  const std::optional<Spec> spec = ctx.spec_of((fs::path(ctx.compat) / it->second).string(), root);
-  if (!spec) return;
-  const std::optional<LoweredConfig> low = ctx.lowered(*spec, config);
+  const LoweredFile loaded = ctx.load((fs::path(ctx.compat) / it->second).string(), root, config);
+  const std::optional<LoweredConfig>& low = loaded.config;
   if (!low) return;
   AssetPackResult pack = load_asset_pack(low->assets);
   if (!pack.ok()) return ctx.fail(dir.string(), pack.error);

@@ -1,24 +1,27 @@
-// Compile directories: safe names, staging and publishing, manifest verification (see compiled_dir.h).
+// Compile directories: safe names, staging and publishing, the manifest, reading back (see compiled_dir.h).
 #include "compiler/compiled_dir.h"
 
 #include <unistd.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <random>
 #include <sstream>
 
 #include "runtime/host/sha256.h"
+#include "runtime/host/specialized_assets.h"
 
 namespace kage {
 
 namespace fs = std::filesystem;
+using Json = nlohmann::json;
 
 namespace {
 
 // The fixed outputs of a compile; the generated source may not take one of these names.
-constexpr const char* kOutputNames[] = {kManifestFile, "params.bin", "spec.json", "assets.bin", "kernels.fatbin",
-                                        "kernels_host.so"};
+constexpr const char* kOutputNames[] = {kManifestFile, kParamsFile, kSpecFile, kAssetsFile, kFatbinFile,
+                                        kHostLibraryFile};
 
 bool plain_file_name(const std::string& name) {
   if (name.empty() || name == "." || name == ".." || name.size() > 200) return false;
@@ -133,6 +136,88 @@ std::optional<std::set<std::string>> verify_compiled_files(const fs::path& dir, 
     names.insert(name);
   }
   return names;
+}
+
+std::string params_blob(const std::vector<uint32_t>& latent_words, const std::vector<uint32_t>& visual_words) {
+  std::string out;
+  for (const std::vector<uint32_t>* words : {&latent_words, &visual_words}) {
+    for (uint32_t w : *words) {
+      for (int b = 0; b < 4; ++b) out.push_back(static_cast<char>((w >> (8 * b)) & 0xffu));
+    }
+  }
+  return out;
+}
+
+std::optional<std::string> manifest_text(const fs::path& dir, const ManifestRecord& r, std::string* error) {
+  Json file_list = Json::array();
+  for (const std::string& f : r.files) {
+    const std::optional<std::string> bytes = read_bytes(dir / f);
+    if (!bytes) {
+      *error = "cannot read back '" + (dir / f).string() + "' to hash it";
+      return std::nullopt;
+    }
+    file_list.push_back({{"name", f}, {"bytes", bytes->size()}, {"sha256", sha256_hex(*bytes)}});
+  }
+  const Json manifest = {
+      {"kagec_manifest", 1},
+      {"spec_sha256", r.spec_sha256},
+      {"codegen_version", r.codegen_version},
+      {"template_sha256", r.template_sha256},
+      {"latent_section_sha256", r.latent_section_sha256},
+      {"config_type", r.config_type},
+      {"source", r.source},
+      {"arch", r.arch},
+      {"params", {{"file", kParamsFile}, {"latent_bytes", sizeof(LatentParams)}, {"visual_offset", sizeof(LatentParams)},
+                  {"visual_bytes", sizeof(VisualParams)}}},
+      {"toolchain", r.toolchain},
+      {"flags", r.flags},
+      {"builds", r.builds},
+      {"files", file_list},
+  };
+  return manifest.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+
+std::optional<CompiledDir> open_compiled_dir(const fs::path& dir, std::string* error) {
+  const std::optional<std::string> text = read_bytes(dir / kManifestFile);
+  if (!text) {
+    *error = std::string("no ") + kManifestFile + " in '" + dir.string() + "' (write one with kagec compile)";
+    return std::nullopt;
+  }
+  CompiledDir c{dir, Json::parse(*text, nullptr, false), {}};
+  if (c.manifest.is_discarded() || !c.manifest.is_object() || c.manifest.value("kagec_manifest", 0) != 1) {
+    *error = "'" + (dir / kManifestFile).string() + "' is not a kagec manifest";
+    return std::nullopt;
+  }
+  // Nothing is loaded from a directory whose files are not exactly the ones its compile wrote.
+  std::optional<std::set<std::string>> files = verify_compiled_files(dir, c.manifest, error);
+  if (!files) return std::nullopt;
+  c.files = std::move(*files);
+  return c;
+}
+
+bool read_compiled_params(const CompiledDir& c, LatentParams* latent, VisualParams* visual, std::string* error) {
+  const std::optional<std::string> bytes = c.has(kParamsFile) ? read_bytes(c.path(kParamsFile)) : std::nullopt;
+  if (!bytes || bytes->size() != sizeof(LatentParams) + sizeof(VisualParams)) {
+    *error = "'" + c.path(kParamsFile).string() + "' is missing or has the wrong size; compile the config again";
+    return false;
+  }
+  std::memcpy(latent, bytes->data(), sizeof(LatentParams));
+  std::memcpy(visual, bytes->data() + sizeof(LatentParams), sizeof(VisualParams));
+  return true;
+}
+
+std::optional<AssetPack> read_compiled_assets(const CompiledDir& c, std::string* error) {
+  const std::optional<std::string> bytes = c.has(kAssetsFile) ? read_bytes(c.path(kAssetsFile)) : std::nullopt;
+  std::optional<AssetPack> pack = bytes ? deserialize_asset_pack(*bytes) : std::nullopt;
+  if (!pack) *error = "'" + c.path(kAssetsFile).string() + "' is missing or not an asset blob (compile without --no-build)";
+  return pack;
+}
+
+std::optional<std::string> read_compiled_source(const CompiledDir& c, std::string* error) {
+  const std::string name = c.source_name();
+  std::optional<std::string> text = c.has(name) ? read_bytes(c.path(name)) : std::nullopt;
+  if (!text) *error = "'" + c.dir.string() + "' has no generated source (its manifest names '" + name + "')";
+  return text;
 }
 
 }  // namespace kage

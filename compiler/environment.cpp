@@ -7,8 +7,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "compiler/resolve.h"
-#include "compiler/source.h"
+#include "compiler/load_lowered.h"
 #include "runtime/latent/latent_params.h"
 #include "runtime/visual/render.h"
 
@@ -70,21 +69,20 @@ EnvironmentResult Environment::open(const std::string& config_path, const Enviro
   DiskFileReader reader;
   ResolveOptions resolve;
   resolve.asset_root = options.asset_root;
-  const std::optional<Spec> spec = analyze_file(config_path, resolve, sources, reader, diags);
+  const LoweredFile loaded = load_lowered(config_path, resolve, sources, reader, diags);
   std::ostringstream text;
   print_text(diags, text);
-  if (!spec || diags.has_errors()) {
+  if (!loaded.spec) {
     EnvironmentResult failed;
     failed.error = text.str() + config_path + ": the config has errors; fix them (kagec lint " + config_path + ")\n";
     return failed;
   }
-  const LowerResult lowered = lower_spec(*spec);
-  if (!lowered.ok()) {
+  if (!loaded.ok()) {
     EnvironmentResult failed;
-    failed.error = config_path + ": " + lowered.error_text();
+    failed.error = config_path + ": " + loaded.lower_errors;
     return failed;
   }
-  EnvironmentResult result = from_lowered(*lowered.config, options);
+  EnvironmentResult result = from_lowered(*loaded.config, options);
   result.warnings = text.str() + result.warnings;
   return result;
 }

@@ -7,18 +7,14 @@
 
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
-#include <set>
 #include <sstream>
 
 #include "compiler/codegen.h"
 #include "compiler/compiled_dir.h"
-#include "compiler/lower.h"
-#include "compiler/resolve.h"
+#include "compiler/load_lowered.h"
 #include "runtime/host/asset_pack.h"
 #include "runtime/host/host_batch.h"
-#include "runtime/host/specialized_assets.h"
 #if defined(KAGE_API_HAVE_CUDA)
 #include "compiler/build.h"
 #include "runtime/cuda/device_batch.h"
@@ -33,14 +29,6 @@ namespace {
 bool fail(std::string* error, const std::string& message) {
   if (error) *error = message;
   return false;
-}
-
-std::optional<std::string> read_file(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  if (!f) return std::nullopt;
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
 }
 
 constexpr InfoFieldDesc kInfoFields[] = {
@@ -98,19 +86,18 @@ std::optional<Loaded> load_yaml(const std::string& path, const Options& options,
   DiskFileReader reader;
   ResolveOptions ro;
   if (!options.asset_root.empty()) ro.asset_root = options.asset_root;
-  const auto spec = analyze_file(path, ro, sources, reader, diags);
-  if (!spec || diags.has_errors()) {
+  LoweredFile loaded = load_lowered(path, ro, sources, reader, diags);
+  if (!loaded.spec) {
     std::ostringstream s;
     print_text(diags, s);
     fail(error, s.str() + "kage::open: no Spec for '" + path + "'");
     return std::nullopt;
   }
-  LowerResult lowered = lower_spec(*spec);
-  if (!lowered.ok()) {
-    fail(error, lowered.error_text());
+  if (!loaded.ok()) {
+    fail(error, loaded.lower_errors);
     return std::nullopt;
   }
-  return Loaded{spec->sha256(), *lowered.config};
+  return Loaded{loaded.spec->sha256(), std::move(*loaded.config)};
 }
 
 /// The CPU backend: a HostBatch over generated code (a compiled dir's kernels_host.so) or the generic path.
@@ -168,10 +155,9 @@ class HostEnv final : public Env {
   std::vector<int32_t> actions_;
 };
 
-std::unique_ptr<Env> open_compiled_cpu(const fs::path& dir, const Json& manifest, const Options& o,
-                                       std::string* error) {
-  const std::string hash = manifest.value("spec_sha256", "");
-  const fs::path so = fs::absolute(dir / "kernels_host.so");
+std::unique_ptr<Env> open_compiled_cpu(const CompiledDir& c, const Options& o, std::string* error) {
+  const std::string hash = c.spec_sha256();
+  const fs::path so = fs::absolute(c.path(kHostLibraryFile));
   void* lib = ::dlopen(so.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!lib) return fail(error, "kage::open: cannot load " + so.string() + " (run kagec compile without --no-build)"), nullptr;
   HostEntryPoints ep{};
@@ -191,8 +177,8 @@ std::unique_ptr<Env> open_compiled_cpu(const fs::path& dir, const Json& manifest
     problem = "missing kage_host_* entry points";
   else if (hash != ep.spec_hash())
     problem = "library built for spec " + std::string(ep.spec_hash()) + ", manifest says " + hash;
-  const auto blob = read_file(dir / "assets.bin");
-  std::optional<AssetPack> pack = blob ? deserialize_asset_pack(*blob) : std::nullopt;
+  std::string unused;
+  std::optional<AssetPack> pack = read_compiled_assets(c, &unused);
   if (problem.empty() && !pack) problem = "assets.bin missing or unreadable";
   if (!problem.empty()) {
     ::dlclose(lib);
@@ -307,35 +293,25 @@ std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::st
 #endif
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
-    const fs::path dir(path);
-    const auto text = read_file(dir / "manifest.json");
     *kind = ErrorKind::kFile;
-    if (!text) return fail(error, "kage::open: no manifest.json in '" + path + "' (write one with kagec compile)"), nullptr;
-    const Json manifest = Json::parse(*text, nullptr, false);
-    if (manifest.is_discarded() || !manifest.is_object() || manifest.value("kagec_manifest", 0) != 1)
-      return fail(error, "kage::open: '" + path + "/manifest.json' is not a kagec manifest"), nullptr;
-    // Nothing is loaded from a directory whose files are not exactly the ones its compile wrote.
     std::string problem;
-    const std::optional<std::set<std::string>> listed = verify_compiled_files(dir, manifest, &problem);
-    if (!listed) return fail(error, "kage::open: " + problem), nullptr;
+    const std::optional<CompiledDir> c = open_compiled_dir(path, &problem);
+    if (!c) return fail(error, "kage::open: " + problem), nullptr;
     if (o.backend == Backend::kCpu) {
-      if (!listed->count("kernels_host.so"))
+      if (!c->has(kHostLibraryFile))
         return fail(error, "kage::open: '" + path + "' has no kernels_host.so (compile without --no-host/--no-build)"),
                nullptr;
-      return open_compiled_cpu(dir, manifest, o, error);
+      return open_compiled_cpu(*c, o, error);
     }
     *kind = ErrorKind::kOther;
 #if defined(KAGE_API_HAVE_CUDA)
-    const auto params = read_file(dir / "params.bin");
-    const auto source = read_file(dir / manifest.value("source", ""));
-    const auto blob = read_file(dir / "assets.bin");
-    std::optional<AssetPack> pack = blob ? deserialize_asset_pack(*blob) : std::nullopt;
-    if (!params || params->size() != sizeof(LatentParams) + sizeof(VisualParams) || !source || !pack)
+    Loaded l{c->spec_sha256(), {}};
+    const bool params = read_compiled_params(*c, &l.config.latent, &l.config.visual, &problem);
+    const std::optional<std::string> source = read_compiled_source(*c, &problem);
+    std::optional<AssetPack> pack = read_compiled_assets(*c, &problem);
+    if (!params || !source || !pack)
       return fail(error, "kage::open: '" + path + "' lacks params.bin, its source or assets.bin"), nullptr;
-    Loaded l{manifest.value("spec_sha256", ""), {}};
-    std::memcpy(&l.config.latent, params->data(), sizeof(LatentParams));
-    std::memcpy(&l.config.visual, params->data() + sizeof(LatentParams), sizeof(VisualParams));
-    const std::string fatbin = listed->count("kernels.fatbin") ? (dir / "kernels.fatbin").string() : std::string();
+    const std::string fatbin = c->has(kFatbinFile) ? c->path(kFatbinFile).string() : std::string();
     return open_gpu(l, *source, fatbin, std::move(*pack), o, error, kind);
 #endif
   }
