@@ -46,23 +46,53 @@ std::optional<int> parse_args(CLI::App& app, const std::vector<std::string>& arg
   return std::nullopt;
 }
 
-std::optional<Spec> resolve_file(const char* command, const std::string& file, const DiagOptions& opts,
-                                 CommandIo& io, int* exit_code) {
+namespace {
+
+/// Applies the options, runs `analyze` against a fresh diagnostics engine and prints what it reported;
+/// false with *exit_code set on a usage error, or when `analyze` produced nothing or errors were reported.
+template <class Analyze>
+bool run_front_end(const char* command, const DiagOptions& opts, CommandIo& io, int* exit_code, Analyze analyze) {
   SourceManager sources;
   DiagEngine diags(sources);
   if (!opts.apply(diags, io)) {
     *exit_code = kExitUsage;
-    return std::nullopt;
+    return false;
   }
   DiskFileReader reader;
-  auto spec = analyze_file(file, opts.resolve_options(), sources, reader, diags);
+  const bool produced = analyze(sources, reader, diags);
   print_text(diags, io.err, io.err_is_terminal);
-  if (!spec || diags.has_errors()) {
-    io.err << "kagec " << command << ": no Spec: fix the errors above\n";
+  if (produced && !diags.has_errors()) return true;
+  io.err << "kagec " << command << ": no Spec: fix the errors above\n";
+  *exit_code = kExitErrors;
+  return false;
+}
+
+}  // namespace
+
+std::optional<Spec> resolve_file(const char* command, const std::string& file, const DiagOptions& opts,
+                                 CommandIo& io, int* exit_code) {
+  std::optional<Spec> spec;
+  const bool ok = run_front_end(command, opts, io, exit_code, [&](SourceManager& s, FileReader& r, DiagEngine& d) {
+    spec = analyze_file(file, opts.resolve_options(), s, r, d);
+    return spec.has_value();
+  });
+  return ok ? spec : std::nullopt;
+}
+
+std::optional<LoweredFile> lower_file(const char* command, const std::string& file, const DiagOptions& opts,
+                                      CommandIo& io, int* exit_code) {
+  LoweredFile loaded;
+  const bool ok = run_front_end(command, opts, io, exit_code, [&](SourceManager& s, FileReader& r, DiagEngine& d) {
+    loaded = load_lowered(file, opts.resolve_options(), s, r, d);
+    return loaded.spec.has_value();
+  });
+  if (!ok) return std::nullopt;
+  if (!loaded.ok()) {
+    io.err << loaded.lower_errors << "kagec " << command << ": the runtime cannot hold this config\n";
     *exit_code = kExitErrors;
     return std::nullopt;
   }
-  return spec;
+  return loaded;
 }
 
 void emit_diagnostics(const DiagEngine& diags, const DiagOptions& opts, CommandIo& io) {

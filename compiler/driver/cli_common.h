@@ -8,6 +8,7 @@
 #include "compiler/basic/diag.h"
 #include "compiler/basic/file_out.h"
 #include "compiler/driver/commands.h"
+#include "compiler/lower/load_lowered.h"
 #include "compiler/sema/resolve.h"
 
 namespace kage {
@@ -31,6 +32,11 @@ std::optional<int> parse_args(CLI::App& app, const std::vector<std::string>& arg
 /// *exit_code set (usage error or errors in the file) after telling the user why.
 std::optional<Spec> resolve_file(const char* command, const std::string& file, const DiagOptions& opts,
                                  CommandIo& io, int* exit_code);
+
+/// resolve_file, then lowering: the config the runtime runs (with its Spec), or nullopt with *exit_code
+/// set after telling the user why (errors in the file, or settings the runtime cannot hold).
+std::optional<LoweredFile> lower_file(const char* command, const std::string& file, const DiagOptions& opts,
+                                      CommandIo& io, int* exit_code);
 
 /// Prints diagnostics in the chosen format.
 void emit_diagnostics(const DiagEngine& diags, const DiagOptions& opts, CommandIo& io);

@@ -10,7 +10,6 @@
 #include "compiler/codegen/codegen.h"
 #include "compiler/codegen/compiled_dir.h"
 #include "compiler/driver/cli_common.h"
-#include "compiler/lower/load_lowered.h"
 #include "runtime/host/specialized_assets.h"
 
 namespace kage {
@@ -41,22 +40,11 @@ int cmd_compile(const std::vector<std::string>& args, CommandIo& io) {
   app.add_flag("--no-host", no_host, "skip the host compiler (kernels_host.so)");
   opts.add_to(app, false);
   if (auto code = parse_args(app, args, io)) return *code;
-  SourceManager sources;
-  DiagEngine diags(sources);
-  if (!opts.apply(diags, io)) return kExitUsage;
-  DiskFileReader reader;
-  const LoweredFile loaded = load_lowered(file, opts.resolve_options(), sources, reader, diags);
-  print_text(diags, io.err, io.err_is_terminal);
-  if (!loaded.spec) {
-    io.err << "kagec compile: no Spec: fix the errors above\n";
-    return kExitErrors;
-  }
-  if (!loaded.ok()) {
-    io.err << loaded.lower_errors << "kagec compile: the runtime cannot hold this config\n";
-    return kExitErrors;
-  }
-  const Spec& spec = *loaded.spec;
-  const LoweredConfig& lowered = *loaded.config;
+  int exit_code = kExitOk;
+  const std::optional<LoweredFile> loaded = lower_file("compile", file, opts, io, &exit_code);
+  if (!loaded) return exit_code;
+  const Spec& spec = *loaded->spec;
+  const LoweredConfig& lowered = *loaded->config;
   GeneratedSource gen = generate_source({spec.sha256(), lowered.latent, lowered.visual});
 
   if (!source_name.empty()) {
