@@ -18,22 +18,39 @@ static_assert(RuntimeCapacity::kNpcSlots == kMaxNpcs && RuntimeCapacity::kSticky
               RuntimeCapacity::kDistractorSlots == kMaxDistractors &&
               RuntimeCapacity::kStickyOffsets == kMaxStickyOffsets && RuntimeCapacity::kListEntries == kMaxListEntries);
 
-/// SHAPE_TYPES in the order of ShapeType, Preset and BackgroundMode (spec 3.3, 3.4, 6.2).
-const char* const kShapeNames[] = {"circle", "square", "line", "ellipse", "triangle",
-                                   "star",   "polygon", "cross", "diamond"};
-const char* const kPresetNames[] = {"none", "vintage", "retro", "cyberpunk", "horror", "noir"};
-const char* const kModeNames[] = {"black", "image", "noise", "color"};
+/// A config name and the runtime value it lowers to.
+template <class E>
+struct NamedValue {
+  const char* name;
+  E value;
+};
 
-template <size_t N>
-const char* name_at(const char* const (&names)[N], int32_t i) {
-  return i >= 0 && static_cast<size_t>(i) < N ? names[i] : "?";
+// The schema's name tables (compiler/generated/spec_fields.h), matched to the runtime's enums by name,
+// so the schema's order cannot disagree with the runtime's values (spec 3.3, 3.4, 6.2).
+#define KAGE_SHAPE(Id, name) {name, ShapeType::k##Id},
+#define KAGE_PRESET(Id, name) {name, Preset::k##Id},
+#define KAGE_MODE(Id, name) {name, BackgroundMode::k##Id},
+constexpr NamedValue<ShapeType> kShapes[] = {KAGE_SCHEMA_SHAPE_TYPES(KAGE_SHAPE)};
+constexpr NamedValue<Preset> kPresets[] = {KAGE_SCHEMA_PRESETS(KAGE_PRESET)};
+constexpr NamedValue<BackgroundMode> kModes[] = {KAGE_SCHEMA_BACKGROUND_MODES(KAGE_MODE)};
+#undef KAGE_SHAPE
+#undef KAGE_PRESET
+#undef KAGE_MODE
+
+/// The value named `name`; `fallback` for a name the table lacks.
+template <class E, size_t N>
+E value_of(const NamedValue<E> (&table)[N], const std::string& name, E fallback) {
+  for (const NamedValue<E>& v : table)
+    if (name == v.name) return v.value;
+  return fallback;
 }
 
-template <size_t N>
-int32_t index_of(const char* const (&names)[N], const std::string& name, int32_t fallback) {
-  for (size_t i = 0; i < N; ++i)
-    if (name == names[i]) return static_cast<int32_t>(i);
-  return fallback;
+/// The name of `value`; "?" for a value the table lacks.
+template <class E, size_t N>
+const char* name_of(const NamedValue<E> (&table)[N], E value) {
+  for (const NamedValue<E>& v : table)
+    if (v.value == value) return v.name;
+  return "?";
 }
 
 Rgb rgb_of(const std::array<int64_t, 3>& c) {
@@ -60,11 +77,11 @@ int32_t fill_colors(const std::vector<std::string>& names, const char* table, Rg
 
 int32_t fill_shapes(const std::vector<std::string>& names, ShapeType* out) {
   const int32_t n = std::min<int32_t>(static_cast<int32_t>(names.size()), kMaxListEntries);
-  for (int32_t i = 0; i < n; ++i) out[i] = static_cast<ShapeType>(index_of(kShapeNames, names[i], 0));
+  for (int32_t i = 0; i < n; ++i) out[i] = value_of(kShapes, names[i], ShapeType::kCircle);
   return n;
 }
 
-Preset preset_of(const std::string& name) { return static_cast<Preset>(index_of(kPresetNames, name, 0)); }
+Preset preset_of(const std::string& name) { return value_of(kPresets, name, Preset::kNone); }
 
 int32_t floor_half(int64_t v) { return static_cast<int32_t>(v >= 0 ? v / 2 : -((-v + 1) / 2)); }
 
@@ -118,7 +135,7 @@ void lower_scene(const spec_fields::Config& c, const LatentParams& lp, VisualPar
   p.jump_velocity = lp.jump_velocity;
 
   const auto& bg = c.background;
-  p.bg_mode = static_cast<BackgroundMode>(index_of(kModeNames, bg.mode, 0));
+  p.bg_mode = value_of(kModes, bg.mode, BackgroundMode::kBlack);
   p.parallax_factor = static_cast<float>(bg.parallax_factor);
   p.tile_horizontal = bg.tile_horizontal;
   p.switch_frequency = static_cast<float>(bg.switch_frequency);
@@ -255,8 +272,8 @@ LowerResult lower_spec(const Spec& spec) {
   return result;
 }
 
-const char* config_name(BackgroundMode mode) { return name_at(kModeNames, static_cast<int32_t>(mode)); }
-const char* config_name(ShapeType shape) { return name_at(kShapeNames, static_cast<int32_t>(shape)); }
-const char* config_name(Preset preset) { return name_at(kPresetNames, static_cast<int32_t>(preset)); }
+const char* config_name(BackgroundMode mode) { return name_of(kModes, mode); }
+const char* config_name(ShapeType shape) { return name_of(kShapes, shape); }
+const char* config_name(Preset preset) { return name_of(kPresets, preset); }
 
 }  // namespace kage

@@ -7,29 +7,39 @@
 
 namespace kage {
 
+namespace {
+
+struct AxisName {
+  Axis axis;
+  const char* name;
+};
+constexpr AxisName kAxisNames[] = {
+#define KAGE_AXIS(Id, name) {Axis::Id, name},
+    KAGE_SCHEMA_AXES(KAGE_AXIS)
+#undef KAGE_AXIS
+};
+
+}  // namespace
+
 const char* axis_name(Axis axis) {
-  switch (axis) {
-    case Axis::Background: return "background";
-    case Axis::Agent: return "agent";
-    case Axis::Distractors: return "distractors";
-    case Axis::Filters: return "filters";
-    case Axis::Effects: return "effects";
-    case Axis::Layout: return "layout";
-    case Axis::Latent: return "latent";
-  }
+  for (const AxisName& a : kAxisNames)
+    if (a.axis == axis) return a.name;
   return "latent";
 }
 
 std::optional<Axis> parse_axis(const std::string& name) {
-  for (Axis a : {Axis::Background, Axis::Agent, Axis::Distractors, Axis::Filters, Axis::Effects, Axis::Layout,
-                 Axis::Latent})
-    if (name == axis_name(a)) return a;
+  for (const AxisName& a : kAxisNames)
+    if (name == a.name) return a.axis;
   return std::nullopt;
 }
 
 const std::vector<Axis>& visual_axes() {
-  static const std::vector<Axis> axes = {Axis::Background, Axis::Agent,   Axis::Distractors,
-                                         Axis::Filters,    Axis::Effects, Axis::Layout};
+  static const std::vector<Axis> axes = [] {
+    std::vector<Axis> out;
+    for (const AxisName& a : kAxisNames)
+      if (a.axis != Axis::Latent) out.push_back(a.axis);
+    return out;
+  }();
   return axes;
 }
 

@@ -11,12 +11,19 @@
 #include <string>
 #include <vector>
 
+#include "compiler/generated/spec_fields.h"
+
 namespace kage {
 
 using Json = nlohmann::json;
 
-/// The benchmark axes. Latent keys change the hidden game; the others only its look.
-enum class Axis { Background, Agent, Distractors, Filters, Effects, Layout, Latent };
+/// The benchmark axes, in the schema's order (definitions/axisName, through the generated
+/// KAGE_SCHEMA_AXES). Latent keys change the hidden game; the others only its look.
+enum class Axis {
+#define KAGE_AXIS(Id, name) Id,
+  KAGE_SCHEMA_AXES(KAGE_AXIS)
+#undef KAGE_AXIS
+};
 
 const char* axis_name(Axis axis);
 std::optional<Axis> parse_axis(const std::string& name);
