@@ -1,4 +1,5 @@
-// YAML documents with source locations: the only place that sees yaml-cpp.
+// YAML documents with source locations: the front end reads YAML only through here (the one other
+// user of yaml-cpp is the driver's probe of whether `kagec bench --gpu` was given a suite manifest).
 //
 // yaml-cpp accepts duplicate keys silently and gives 0-based marks; here every
 // node gets a byte Range, duplicates are reported, and plain scalars are typed

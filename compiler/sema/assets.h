@@ -1,5 +1,7 @@
-// Assets of a configuration: located with the original's precedence and
-// directory rules (spec 2.4), checked to exist and decode, content-hashed.
+// Assets of a configuration: located next to the config that names them (or under --asset-root;
+// a path found only under the working directory, where the original looks, is used from there with a
+// note), expanded with the original's directory rules (spec 2.4), checked to exist and to decode as the
+// runtime decodes them, content-hashed.
 #pragma once
 
 #include "compiler/basic/diag.h"

@@ -1,6 +1,8 @@
 // The configuration schema as a table: one entry per key, read from
-// schemas/kage-config.schema.json (embedded at build time). Every pass that
-// needs to know about keys asks this table; no key is listed anywhere else.
+// schemas/kage-config.schema.json (embedded at build time). Passes that need to
+// know about keys ask this table; the only other lists of keys are generated
+// from the same schema (compiler/generated/spec_fields.h) or name the asset
+// groups (key_refs.h).
 #pragma once
 
 #include <array>
