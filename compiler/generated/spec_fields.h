@@ -1,6 +1,6 @@
 // Generated from schemas/kage-config.schema.json by kage_schemagen; do not edit.
 // The typed view of a resolved Spec's values: one member per key (legacy aliases
-// are resolved into their modern key and do not appear).
+// are resolved into their modern key and do not appear), then the schema's name tables.
 #pragma once
 
 #include <array>
@@ -303,3 +303,41 @@ inline Config from_json(const nlohmann::json& c) {
 }
 
 }  // namespace kage::spec_fields
+
+// The shape types (ShapeType), in the schema's order (/definitions/shapeType/enum).
+#define KAGE_SCHEMA_SHAPE_TYPES(X) \
+  X(Circle, "circle") \
+  X(Square, "square") \
+  X(Line, "line") \
+  X(Ellipse, "ellipse") \
+  X(Triangle, "triangle") \
+  X(Star, "star") \
+  X(Polygon, "polygon") \
+  X(Cross, "cross") \
+  X(Diamond, "diamond")
+
+// The filter presets (Preset), in the schema's order (/definitions/presetName/enum).
+#define KAGE_SCHEMA_PRESETS(X) \
+  X(Vintage, "vintage") \
+  X(Retro, "retro") \
+  X(Cyberpunk, "cyberpunk") \
+  X(Horror, "horror") \
+  X(Noir, "noir") \
+  X(None, "none")
+
+// The background modes (BackgroundMode), in the schema's order (/properties/background/properties/mode/enum).
+#define KAGE_SCHEMA_BACKGROUND_MODES(X) \
+  X(Black, "black") \
+  X(Image, "image") \
+  X(Noise, "noise") \
+  X(Color, "color")
+
+// The certification axes (Axis), in the schema's order (/definitions/axisName/enum).
+#define KAGE_SCHEMA_AXES(X) \
+  X(Background, "background") \
+  X(Agent, "agent") \
+  X(Distractors, "distractors") \
+  X(Filters, "filters") \
+  X(Effects, "effects") \
+  X(Layout, "layout") \
+  X(Latent, "latent")

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "compiler/codegen.h"
-#include "compiler/isolation.h"
-#include "compiler/lower.h"
-#include "compiler/resolve.h"
+#include "compiler/codegen/codegen.h"
+#include "compiler/lower/lower.h"
+#include "compiler/sema/resolve.h"
+#include "verify/isolation/isolation.h"
 
 namespace {
 

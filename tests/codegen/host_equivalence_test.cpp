@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "compiler/codegen.h"
-#include "compiler/environment.h"
+#include "api/environment.h"
+#include "compiler/codegen/codegen.h"
 #include "runtime/cpu/host_batch.h"
 #include "tests/codegen/host_registry.h"
 

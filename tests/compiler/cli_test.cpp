@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include "compiler/commands.h"
+#include "compiler/driver/commands.h"
 #include "test_support.h"
 
 namespace kage::test {

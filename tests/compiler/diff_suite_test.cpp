@@ -2,8 +2,8 @@
 // copies of it that must fail); compatibility with the original's own files.
 #include <catch2/catch.hpp>
 
-#include "compiler/diff.h"
-#include "compiler/suite.h"
+#include "compiler/analysis/diff.h"
+#include "compiler/analysis/suite.h"
 #include "test_support.h"
 #include "tests/skip.h"
 

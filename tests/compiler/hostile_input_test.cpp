@@ -4,8 +4,8 @@
 
 #include <sys/stat.h>
 
-#include "compiler/compose.h"
-#include "compiler/diag.h"
+#include "compiler/basic/diag.h"
+#include "compiler/parse/compose.h"
 #include "test_support.h"
 
 namespace kage::test {

@@ -11,8 +11,8 @@
 #include <regex>
 #include <set>
 
-#include "compiler/compose.h"
-#include "compiler/suite.h"
+#include "compiler/analysis/suite.h"
+#include "compiler/parse/compose.h"
 #include "test_support.h"
 
 namespace kage::test {

@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 
-#include "compiler/assets.h"
+#include "compiler/sema/assets.h"
 #include "test_support.h"
 
 namespace kage::test {

@@ -6,8 +6,8 @@
 #include <map>
 #include <set>
 
-#include "compiler/schema.h"
-#include "compiler/spell.h"
+#include "compiler/basic/spell.h"
+#include "compiler/sema/schema.h"
 
 namespace kage::test {
 namespace {

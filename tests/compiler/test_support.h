@@ -12,9 +12,9 @@
 
 #include <unistd.h>
 
-#include "compiler/diag.h"
-#include "compiler/resolve.h"
-#include "compiler/source.h"
+#include "compiler/basic/diag.h"
+#include "compiler/basic/source.h"
+#include "compiler/sema/resolve.h"
 
 namespace kage::test {
 

@@ -2,7 +2,7 @@
 // yaml-cpp writes as stray Latin-1 bytes restored, so canonical JSON never holds broken UTF-8.
 #include <catch2/catch.hpp>
 
-#include "compiler/utf8.h"
+#include "compiler/basic/utf8.h"
 #include "test_support.h"
 
 namespace kage::test {

@@ -19,9 +19,9 @@
 #include <sstream>
 #include <string>
 
-#include "compiler/compose.h"
-#include "compiler/diag.h"
-#include "compiler/resolve.h"
+#include "compiler/basic/diag.h"
+#include "compiler/parse/compose.h"
+#include "compiler/sema/resolve.h"
 
 namespace kage {
 

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "compiler/commands.h"
+#include "compiler/driver/commands.h"
 #include "runtime/io/image_io.h"
 #include "tests/integration/integration_support.h"
 

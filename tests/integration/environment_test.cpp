@@ -6,7 +6,7 @@
 #include <set>
 #include <vector>
 
-#include "compiler/environment.h"
+#include "api/environment.h"
 #include "tests/integration/integration_support.h"
 
 namespace {

@@ -4,11 +4,11 @@
 
 #include <sstream>
 
-#include "compiler/commands.h"
-#include "compiler/environment.h"
-#include "compiler/lower.h"
-#include "compiler/resolve.h"
-#include "compiler/schema.h"
+#include "api/environment.h"
+#include "compiler/driver/commands.h"
+#include "compiler/lower/lower.h"
+#include "compiler/sema/resolve.h"
+#include "compiler/sema/schema.h"
 #include "tests/integration/integration_support.h"
 
 namespace {

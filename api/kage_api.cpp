@@ -1,0 +1,359 @@
+// The public API (include/kage/kage.h): a compiled config dir or a YAML file -> a CPU or GPU batch.
+// CPU: HostBatch over the generated kernels_host.so (compiled dir) or the generic path (YAML). GPU:
+// DeviceBatch (runtime/cuda).
+#include "kage/kage.h"
+
+#include <dlfcn.h>
+
+#include <cstring>
+#include <filesystem>
+#include <iterator>
+#include <sstream>
+
+#include "compiler/codegen/codegen.h"
+#include "compiler/codegen/compiled_dir.h"
+#include "compiler/lower/load_lowered.h"
+#include "runtime/cpu/host_batch.h"
+#include "runtime/io/asset_pack.h"
+#if defined(KAGE_API_HAVE_CUDA)
+#include "compiler/codegen/build.h"
+#include "runtime/cuda/device_batch.h"
+#endif
+
+namespace kage {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+constexpr InfoFieldDesc kInfoFields[] = {
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) {InfoField::k##Enum, name, DType::dtype, doc},
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+};
+
+template <class T>
+const void* column_data(const std::vector<T>& v) {
+  return v.data();
+}
+template <class T>
+const void* column_data(T* p) {
+  return p;
+}
+
+/// Column `field` of an info table (host or device pointers).
+template <class Table>
+const void* info_column(const Table& t, InfoField field) {
+  switch (field) {
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) \
+  case InfoField::k##Enum:                                     \
+    return column_data(t.member);
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+  }
+  return nullptr;
+}
+
+/// Host actions as int32, checked to be in 0..7; the reason when they are not.
+std::string host_actions(const Actions& a, int32_t n, std::vector<int32_t>* out) {
+  if (a.dtype != DType::kInt32 && a.dtype != DType::kInt64) return "actions must be int32 or int64";
+  out->resize(static_cast<size_t>(n));
+  for (int32_t i = 0; i < n; ++i) {
+    const int64_t at = static_cast<int64_t>(i) * a.stride;
+    const int64_t v = a.dtype == DType::kInt64 ? static_cast<const int64_t*>(a.data)[at]
+                                               : static_cast<const int32_t*>(a.data)[at];
+    if (v < 0 || v > 7)
+      return "action " + std::to_string(v) + " for environment " + std::to_string(i) + ": " + action_range_text();
+    (*out)[static_cast<size_t>(i)] = static_cast<int32_t>(v);
+  }
+  return {};
+}
+
+/// A lowered config with its Spec hash, from a YAML file or a compiled dir's params.bin.
+struct Loaded {
+  std::string spec_hash;
+  LoweredConfig config;
+};
+
+std::optional<Loaded> load_yaml(const std::string& path, const Options& options, std::string* error) {
+  SourceManager sources;
+  DiagEngine diags(sources);
+  DiskFileReader reader;
+  ResolveOptions ro;
+  if (!options.asset_root.empty()) ro.asset_root = options.asset_root;
+  LoweredFile loaded = load_lowered(path, ro, sources, reader, diags);
+  if (!loaded.spec) {
+    std::ostringstream s;
+    print_text(diags, s);
+    fail(error, s.str() + "kage::open: no Spec for '" + path + "'");
+    return std::nullopt;
+  }
+  if (!loaded.ok()) {
+    fail(error, loaded.lower_errors);
+    return std::nullopt;
+  }
+  return Loaded{loaded.spec->sha256(), std::move(*loaded.config)};
+}
+
+/// The CPU backend: a HostBatch over generated code (a compiled dir's kernels_host.so) or the generic path.
+class HostEnv final : public Env {
+ public:
+  HostEnv(void* lib, std::unique_ptr<HostKernels> kernels, AssetPack pack, const Options& o, std::string hash)
+      : lib_(lib), pack_(std::move(pack)), batch_(std::move(kernels), pack_.view(), o.num_envs, o.num_threads),
+        hash_(std::move(hash)) {}
+  ~HostEnv() override {
+    if (lib_) ::dlclose(lib_);
+  }
+  bool reset(const uint64_t* seeds, const uint8_t* mask, std::string*) override {
+    return batch_.reset(seeds, mask), true;
+  }
+  bool step(const Actions& a, std::string* e) override {
+    if (a.memory != Memory::kHost) return fail(e, "kage: device actions given to a CPU environment: pass host memory");
+    const std::string problem = host_actions(a, batch_.size(), &actions_);
+    if (!problem.empty()) return fail(e, "kage: " + problem);
+    return batch_.step(actions_.data()), true;
+  }
+  Backend backend() const override { return Backend::kCpu; }
+  int32_t num_envs() const override { return batch_.size(); }
+  int32_t height() const override { return batch_.visual_params().H; }
+  int32_t width() const override { return batch_.visual_params().W; }
+  const std::string& spec_hash() const override { return hash_; }
+  void set_stream(void*) override {}
+  void* stream() const override { return nullptr; }
+  const uint8_t* obs() const override { return batch_.observations(); }
+  const float* reward() const override { return batch_.info().reward.data(); }
+  const uint8_t* terminated() const override { return batch_.info().terminated.data(); }
+  const uint8_t* truncated() const override { return batch_.info().truncated.data(); }
+  const void* info(InfoField f) const override { return info_column(batch_.info(), f); }
+  const uint8_t* final_mask() const override { return batch_.final_mask(); }
+  const uint8_t* final_obs() const override { return batch_.final_observations(); }
+  const void* final_info(InfoField f) const override { return info_column(batch_.final_info(), f); }
+  bool copy_obs(uint8_t* dst, std::string*) const override {
+    std::memcpy(dst, batch_.observations(), batch_.frame_bytes() * static_cast<size_t>(batch_.size()));
+    return true;
+  }
+  bool synchronize(std::string*) override { return true; }
+  std::string pending_error() override { return {}; }
+  bool save_state(std::vector<uint8_t>* out, std::string*) const override {
+    return *out = batch_.save_state(hash_), true;
+  }
+  bool load_state(const uint8_t* data, size_t size, std::string* e) override {
+    const std::string problem = batch_.load_state(data, size, hash_);
+    return problem.empty() || fail(e, "kage: load_state: " + problem);
+  }
+
+ private:
+  void* lib_;
+  AssetPack pack_;
+  HostBatch batch_;
+  std::string hash_;
+  std::vector<int32_t> actions_;
+};
+
+std::unique_ptr<Env> open_compiled_cpu(const CompiledDir& c, const Options& o, std::string* error) {
+  const std::string hash = c.spec_sha256();
+  const fs::path so = fs::absolute(c.path(kHostLibraryFile));
+  void* lib = ::dlopen(so.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!lib) return fail(error, "kage::open: cannot load " + so.string() + " (run kagec compile without --no-build)"), nullptr;
+  HostEntryPoints ep{};
+  ep.abi_version = reinterpret_cast<decltype(ep.abi_version)>(::dlsym(lib, "kage_host_abi_version"));
+  ep.spec_hash = reinterpret_cast<decltype(ep.spec_hash)>(::dlsym(lib, "kage_host_spec_hash"));
+  ep.params = reinterpret_cast<decltype(ep.params)>(::dlsym(lib, "kage_host_params"));
+  ep.reset_env = reinterpret_cast<decltype(ep.reset_env)>(::dlsym(lib, "kage_host_reset_env"));
+  ep.step_env = reinterpret_cast<decltype(ep.step_env)>(::dlsym(lib, "kage_host_step_env"));
+  ep.render_env = reinterpret_cast<decltype(ep.render_env)>(::dlsym(lib, "kage_host_render_env"));
+  std::string problem;
+  if (!ep.abi_version)
+    problem = "missing kage_host_* entry points";
+  else if (ep.abi_version() != kHostAbiVersion)
+    problem = "host ABI " + std::to_string(ep.abi_version()) + ", this program speaks " +
+              std::to_string(kHostAbiVersion) + ": compile the config again with this kagec";
+  else if (!ep.spec_hash || !ep.params || !ep.reset_env || !ep.step_env || !ep.render_env)
+    problem = "missing kage_host_* entry points";
+  else if (hash != ep.spec_hash())
+    problem = "library built for spec " + std::string(ep.spec_hash()) + ", manifest says " + hash;
+  std::string unused;
+  std::optional<AssetPack> pack = read_compiled_assets(c, &unused);
+  if (problem.empty() && !pack) problem = "assets.bin missing or unreadable";
+  if (!problem.empty()) {
+    ::dlclose(lib);
+    return fail(error, "kage::open: " + so.string() + ": " + problem), nullptr;
+  }
+  return std::make_unique<HostEnv>(lib, generated_host_kernels(ep), std::move(*pack), o, hash);
+}
+
+#if defined(KAGE_API_HAVE_CUDA)
+/// GPU over runtime/cuda: a fatbin, or NVRTC on the generated source.
+class GpuEnv final : public Env {
+ public:
+  GpuEnv(CUcontext ctx, CudaModule m, DeviceBatch b, AssetPack pack, int32_t H, int32_t W, std::string hash)
+      : ctx_(ctx), module_(std::move(m)), pack_(std::move(pack)), batch_(std::move(b)), H_(H), W_(W),
+        hash_(std::move(hash)) {}
+  // The members free device memory: in this batch's context, whichever thread drops the last reference.
+  ~GpuEnv() override { cuCtxSetCurrent(ctx_); }
+  bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* e) override {
+    return bind(e) && no_pending_error(e) && batch_.reset(seeds, mask, e);
+  }
+  bool step(const Actions& a, std::string* e) override {
+    if (!bind(e) || !no_pending_error(e)) return false;
+    if (a.memory == Memory::kDevice) {
+      if (a.dtype != DType::kInt32 && a.dtype != DType::kInt64) return fail(e, "kage: actions must be int32 or int64");
+      return batch_.step(DeviceActions{reinterpret_cast<CUdeviceptr>(a.data), a.stride, a.dtype == DType::kInt64}, e);
+    }
+    const std::string problem = host_actions(a, batch_.size(), &actions_);
+    if (!problem.empty()) return fail(e, "kage: " + problem);
+    return batch_.step(actions_.data(), e);
+  }
+  Backend backend() const override { return Backend::kGpu; }
+  int32_t num_envs() const override { return batch_.size(); }
+  int32_t height() const override { return H_; }
+  int32_t width() const override { return W_; }
+  const std::string& spec_hash() const override { return hash_; }
+  void set_stream(void* stream) override { batch_.set_stream(static_cast<CUstream>(stream)); }
+  void* stream() const override { return batch_.stream(); }
+  const uint8_t* obs() const override { return reinterpret_cast<const uint8_t*>(batch_.obs()); }
+  const float* reward() const override { return reinterpret_cast<const float*>(batch_.reward()); }
+  const uint8_t* terminated() const override { return reinterpret_cast<const uint8_t*>(batch_.terminated()); }
+  const uint8_t* truncated() const override { return reinterpret_cast<const uint8_t*>(batch_.truncated()); }
+  const void* info(InfoField f) const override { return info_column(batch_.info(), f); }
+  const uint8_t* final_mask() const override { return reinterpret_cast<const uint8_t*>(batch_.final_mask()); }
+  const uint8_t* final_obs() const override { return reinterpret_cast<const uint8_t*>(batch_.final_obs()); }
+  const void* final_info(InfoField f) const override { return info_column(batch_.final_info(), f); }
+  bool copy_obs(uint8_t* dst, std::string* e) const override { return bind(e) && batch_.download_obs(dst, e); }
+  bool synchronize(std::string* e) override { return bind(e) && batch_.synchronize(e) && no_pending_error(e); }
+  std::string pending_error() override {
+    const std::optional<ActionError> e = batch_.take_action_error();
+    if (!e) return {};
+    return "kage: the actions of step " + std::to_string(e->step) + " held " + std::to_string(e->value) +
+           " for environment " + std::to_string(e->env) + ": " + action_range_text() +
+           "; that step ran with the value masked to its low 3 bits";
+  }
+  bool save_state(std::vector<uint8_t>* out, std::string* e) const override {
+    return bind(e) && batch_.save_state(hash_, out, e);
+  }
+  bool load_state(const uint8_t* data, size_t size, std::string* e) override {
+    return bind(e) && (batch_.load_state(data, size, hash_, e) || fail(e, "kage: load_state: " + *e));
+  }
+
+ private:
+  /// Makes the batch's context current: the driver API acts on the calling thread's context, and the
+  /// caller may be another thread than the one that opened the batch.
+  bool bind(std::string* e) const {
+    const CUresult r = cuCtxSetCurrent(ctx_);
+    return r == CUDA_SUCCESS || fail(e, cu_error_text(r, "cuCtxSetCurrent"));
+  }
+  bool no_pending_error(std::string* e) {
+    const std::string problem = pending_error();
+    return problem.empty() || fail(e, problem);
+  }
+
+  CUcontext ctx_;
+  CudaModule module_;
+  AssetPack pack_;
+  DeviceBatch batch_;
+  int32_t H_, W_;
+  std::string hash_;
+  std::vector<int32_t> actions_;
+};
+
+std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const std::string& fatbin, AssetPack pack,
+                              const Options& o, std::string* error, ErrorKind* kind) {
+  const CUcontext ctx = cuda_primary_context(error);
+  if (!ctx) return *kind = ErrorKind::kDevice, nullptr;
+  std::optional<CudaModule> m;
+  if (!fatbin.empty()) {
+    m = CudaModule::load_file(fatbin, error);
+  } else {
+    NvrtcOptions no;
+    no.include_dir = runtime_include_dir();
+    no.generator_version = std::to_string(kCodegenVersion);
+    m = CudaModule::compile(source, "kage_" + l.spec_hash.substr(0, 16) + ".cu", no, error);
+  }
+  if (!m) return nullptr;
+  auto b = DeviceBatch::create(*m, l.config.latent, l.config.visual, pack.view(), o.num_envs, error);
+  if (!b) return nullptr;
+  b->set_stream(static_cast<CUstream>(o.stream));
+  return std::make_unique<GpuEnv>(ctx, std::move(*m), std::move(*b), std::move(pack), l.config.visual.H, l.config.visual.W,
+                                  l.spec_hash);
+}
+#endif
+
+/// open() without the final error kind: sets *kind where a failure has a specific one.
+std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::string* error, ErrorKind* kind) {
+  if (o.num_envs <= 0 || o.num_threads <= 0)
+    return *kind = ErrorKind::kUsage, fail(error, "kage::open: num_envs and num_threads must be positive"), nullptr;
+#if !defined(KAGE_API_HAVE_CUDA)
+  if (o.backend == Backend::kGpu)
+    return *kind = ErrorKind::kDevice, fail(error, "kage::open: GPU backend not built (no CUDA toolkit at build time)"), nullptr;
+#endif
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    *kind = ErrorKind::kFile;
+    std::string problem;
+    const std::optional<CompiledDir> c = open_compiled_dir(path, &problem);
+    if (!c) return fail(error, "kage::open: " + problem), nullptr;
+    if (o.backend == Backend::kCpu) {
+      if (!c->has(kHostLibraryFile))
+        return fail(error, "kage::open: '" + path + "' has no kernels_host.so (compile without --no-host/--no-build)"),
+               nullptr;
+      return open_compiled_cpu(*c, o, error);
+    }
+    *kind = ErrorKind::kOther;
+#if defined(KAGE_API_HAVE_CUDA)
+    Loaded l{c->spec_sha256(), {}};
+    const bool params = read_compiled_params(*c, &l.config.latent, &l.config.visual, &problem);
+    const std::optional<std::string> source = read_compiled_source(*c, &problem);
+    std::optional<AssetPack> pack = read_compiled_assets(*c, &problem);
+    if (!params || !source || !pack)
+      return fail(error, "kage::open: '" + path + "' lacks params.bin, its source or assets.bin"), nullptr;
+    const std::string fatbin = c->has(kFatbinFile) ? c->path(kFatbinFile).string() : std::string();
+    return open_gpu(l, *source, fatbin, std::move(*pack), o, error, kind);
+#endif
+  }
+  std::optional<Loaded> l = load_yaml(path, o, error);
+  if (!l) return *kind = ErrorKind::kConfig, nullptr;
+  AssetPackResult assets = load_asset_pack(l->config.assets);
+  if (!assets.ok()) return fail(error, "kage::open: " + assets.error), nullptr;
+  if (o.backend == Backend::kCpu)
+    return std::make_unique<HostEnv>(nullptr, generic_host_kernels(l->config.latent, l->config.visual),
+                                     std::move(*assets.pack), o, l->spec_hash);
+#if defined(KAGE_API_HAVE_CUDA)
+  const GeneratedSource g = generate_source({l->spec_hash, l->config.latent, l->config.visual});
+  return open_gpu(*l, g.text, "", std::move(*assets.pack), o, error, kind);
+#else
+  return nullptr;
+#endif
+}
+
+}  // namespace
+
+const char* action_range_text() { return "an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump)"; }
+
+const InfoFieldDesc* info_fields(int32_t* count) {
+  *count = static_cast<int32_t>(std::size(kInfoFields));
+  return kInfoFields;
+}
+
+bool gpu_backend_built() {
+#if defined(KAGE_API_HAVE_CUDA)
+  return true;
+#else
+  return false;
+#endif
+}
+
+std::unique_ptr<Env> open(const std::string& path, const Options& o, std::string* error, ErrorKind* kind_out) {
+  ErrorKind ignored = ErrorKind::kOther;
+  ErrorKind* kind = kind_out ? kind_out : &ignored;
+  *kind = ErrorKind::kOther;
+  std::unique_ptr<Env> env = open_any(path, o, error, kind);
+  if (env) *kind = ErrorKind::kNone;
+  return env;
+}
+
+}  // namespace kage

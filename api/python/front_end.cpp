@@ -1,0 +1,61 @@
+// The config compiler's front end for the Python package (see front_end.h).
+#include "api/python/front_end.h"
+
+#include <sstream>
+
+#include "compiler/analysis/diff.h"
+#include "compiler/analysis/suite.h"
+#include "compiler/basic/file_out.h"
+
+namespace kage::python {
+namespace {
+
+ResolveOptions options_for(const std::string& asset_root) {
+  ResolveOptions o;
+  if (!asset_root.empty()) o.asset_root = asset_root;
+  return o;
+}
+
+std::string diagnostics_text(const DiagEngine& diags) {
+  std::ostringstream s;
+  print_text(diags, s);
+  return s.str();
+}
+
+}  // namespace
+
+FrontEndResult resolve_config_json(const std::string& path, const std::string& asset_root) {
+  SourceManager sources;
+  DiagEngine diags(sources);
+  DiskFileReader reader;
+  const auto spec = analyze_file(path, options_for(asset_root), sources, reader, diags);
+  if (!spec || diags.has_errors()) return {"", diagnostics_text(diags) + "kage: no Spec for '" + path + "'"};
+  return {spec->canonical_text(), ""};
+}
+
+FrontEndResult certify_pair_json(const std::string& train, const std::string& eval, const std::string& asset_root) {
+  SourceManager sources;
+  DiagEngine diags(sources);
+  DiskFileReader reader;
+  const auto t = analyze_file(train, options_for(asset_root), sources, reader, diags);
+  const auto e = analyze_file(eval, options_for(asset_root), sources, reader, diags);
+  if (!t || !e || diags.has_errors()) return {"", diagnostics_text(diags) + "kage: cannot certify '" + train + "' / '" + eval + "'"};
+  const SpecDiff diff = diff_specs(*t, *e, config_schema());
+  const Certification cert = certify(diff, std::nullopt, {});
+  return {json_file_text(certificate_json({train, t->sha256()}, {eval, e->sha256()}, diff, cert)), ""};
+}
+
+FrontEndResult suite_report(const std::string& manifest) {
+  SourceManager sources;
+  DiagEngine diags(sources);
+  DiskFileReader reader;
+  const auto suite = load_suite(manifest, sources, reader, diags);
+  if (!suite || diags.has_errors()) return {"", diagnostics_text(diags) + "kage: cannot read suite '" + manifest + "'"};
+  const SuiteReport report = run_suite(*suite, ResolveOptions{}, sources, reader, diags, nullptr);
+  diags.disable_warnings();
+  for (const PairResult& r : report.results)
+    if (!r.lint_ok) return {"", diagnostics_text(diags) + "kage: suite '" + manifest + "' has configs with errors"};
+  return {json_file_text(suite_report_json(*suite, report)), ""};
+}
+
+}  // namespace kage::python

@@ -1,0 +1,471 @@
+// kage._kage: the Python binding of include/kage/kage.h (pybind11). It opens batches, steps them with
+// actions from numpy arrays, DLPack capsules or raw device pointers, and exports every output without
+// a copy: host outputs as numpy arrays, device outputs as DeviceArray (DLPack and
+// __cuda_array_interface__). The Python package (python/kage/) builds the Gymnasium-style API on it.
+//
+// Lifetime: an exported array holds a reference to its batch, so the memory stays allocated while any
+// array, tensor or capsule views it, even after close(); its contents change with the next reset/step.
+#include <dlpack/dlpack.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <iterator>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "api/python/cuda_streams.h"
+#include "api/python/front_end.h"
+#include "kage/kage.h"
+
+namespace py = pybind11;
+
+namespace {
+
+/// Raised by open(): a Python exception class and the kind it stands for (set up in the module init).
+struct OpenErrors {
+  py::object config, file, device, usage, other;
+};
+OpenErrors& open_errors() {
+  static OpenErrors e;
+  return e;
+}
+
+void raise_value_error(const std::string& message) { throw py::value_error(message); }
+
+/// Each kage::DType (in its enum order) as DLPack, __array_interface__ and byte size see it.
+struct DTypeFacts {
+  DLDataType dl;
+  const char* typestr;
+  size_t bytes;
+};
+constexpr DTypeFacts kDTypes[] = {
+    {{kDLUInt, 8, 1}, "|u1", 1}, {{kDLInt, 32, 1}, "<i4", 4}, {{kDLInt, 64, 1}, "<i8", 8}, {{kDLFloat, 32, 1}, "<f4", 4}};
+static_assert(std::size(kDTypes) == static_cast<size_t>(kage::DType::kFloat32) + 1, "a DType without facts");
+
+const DTypeFacts& facts(kage::DType t) { return kDTypes[static_cast<size_t>(t)]; }
+py::dtype numpy_dtype(kage::DType t) { return py::dtype(facts(t).typestr); }
+
+/// One output array of a batch on the GPU: device memory owned by the batch.
+class DeviceArray {
+ public:
+  DeviceArray(std::shared_ptr<kage::Env> owner, const void* data, std::vector<int64_t> shape, kage::DType dtype)
+      : owner_(std::move(owner)), data_(data), shape_(std::move(shape)), dtype_(dtype) {}
+
+  /// A DLPack capsule of this array, ready for use on `consumer_stream` (the DLPack protocol's value:
+  /// None or 1 the legacy default stream, 2 the per-thread default stream, -1 no ordering, else a
+  /// CUstream handle).
+  py::capsule dlpack(const py::object& consumer_stream) const {
+    const int64_t s = consumer_stream.is_none() ? 1 : consumer_stream.cast<int64_t>();
+    if (s == 0) raise_value_error("__dlpack__: stream 0 is ambiguous for CUDA; pass 1 for the legacy default stream");
+    std::string error;
+    if (s != -1 && !kage::python::order_after(owner_->stream(), kage::python::protocol_stream(s), &error))
+      throw std::runtime_error(error);
+    struct Context {
+      std::shared_ptr<kage::Env> owner;
+      std::vector<int64_t> shape;
+    };
+    auto* ctx = new Context{owner_, shape_};
+    auto* t = new DLManagedTensor{};
+    t->dl_tensor.data = const_cast<void*>(data_);
+    t->dl_tensor.device = {kDLCUDA, 0};
+    t->dl_tensor.ndim = static_cast<int32_t>(ctx->shape.size());
+    t->dl_tensor.dtype = facts(dtype_).dl;
+    t->dl_tensor.shape = ctx->shape.data();
+    t->dl_tensor.strides = nullptr;
+    t->dl_tensor.byte_offset = 0;
+    t->manager_ctx = ctx;
+    // Runs without the GIL when the consumer frees its tensor: C++ objects only.
+    t->deleter = [](DLManagedTensor* self) {
+      delete static_cast<Context*>(self->manager_ctx);
+      delete self;
+    };
+    return py::capsule(t, "dltensor", [](PyObject* capsule) {
+      // A consumer renames a capsule it took ("used_dltensor") and owns it from then on.
+      if (PyCapsule_IsValid(capsule, "dltensor")) {
+        auto* t = static_cast<DLManagedTensor*>(PyCapsule_GetPointer(capsule, "dltensor"));
+        if (t && t->deleter) t->deleter(t);
+      }
+    });
+  }
+
+  py::dict cuda_array_interface() const {
+    py::dict d;
+    py::tuple shape(shape_.size());
+    for (size_t i = 0; i < shape_.size(); ++i) shape[i] = shape_[i];
+    d["shape"] = shape;
+    d["typestr"] = facts(dtype_).typestr;
+    d["data"] = py::make_tuple(reinterpret_cast<uintptr_t>(data_), false);
+    d["version"] = 3;
+    d["strides"] = py::none();
+    // Version 3: the stream the data is ready on (1: the legacy default stream).
+    const uintptr_t s = reinterpret_cast<uintptr_t>(owner_->stream());
+    d["stream"] = s == 0 ? uintptr_t{1} : s;
+    return d;
+  }
+
+  /// A host copy as a numpy array (waits for the batch's queued work).
+  py::array numpy() const {
+    py::array out(numpy_dtype(dtype_), shape_);
+    std::string error;
+    if (!kage::python::copy_to_host(out.mutable_data(), data_, static_cast<size_t>(out.nbytes()), owner_->stream(),
+                                    &error))
+      throw std::runtime_error(error);
+    return out;
+  }
+
+  py::tuple shape() const {
+    py::tuple t(shape_.size());
+    for (size_t i = 0; i < shape_.size(); ++i) t[i] = shape_[i];
+    return t;
+  }
+  py::dtype dtype() const { return numpy_dtype(dtype_); }
+  uintptr_t data_ptr() const { return reinterpret_cast<uintptr_t>(data_); }
+
+ private:
+  std::shared_ptr<kage::Env> owner_;
+  const void* data_;
+  std::vector<int64_t> shape_;
+  kage::DType dtype_;
+};
+
+/// A batch as Python sees it: kage::Env plus the export of its outputs.
+class PyEnv {
+ public:
+  explicit PyEnv(std::shared_ptr<kage::Env> env) : env_(std::move(env)) {}
+
+  /// The output `name` ("obs", "reward", "terminated", "truncated", "final_mask", "final_obs", or
+  /// "info/<field>", "final_info/<field>") as a numpy array (CPU) or a DeviceArray (GPU).
+  py::object output(const std::string& name) const {
+    const Located l = locate(name);
+    return export_array(l.data, l.shape, l.dtype);
+  }
+
+  /// The runtime's own pointer to output `name` (host or device address), for checks of zero copy.
+  uintptr_t data_ptr(const std::string& name) const { return reinterpret_cast<uintptr_t>(locate(name).data); }
+
+ private:
+  struct Located {
+    const void* data;
+    std::vector<int64_t> shape;
+    kage::DType dtype;
+  };
+
+  Located locate(const std::string& name) const {
+    const int64_t n = env().num_envs();
+    Located l{nullptr, {n}, kage::DType::kUInt8};
+    if (name == "obs" || name == "final_obs") {
+      l.shape = {n, env().height(), env().width(), 3};
+      l.data = name == "obs" ? env().obs() : env().final_obs();
+    } else if (name == "reward") {
+      l.data = env().reward();
+      l.dtype = kage::DType::kFloat32;
+    } else if (name == "terminated") {
+      l.data = env().terminated();
+    } else if (name == "truncated") {
+      l.data = env().truncated();
+    } else if (name == "final_mask") {
+      l.data = env().final_mask();
+    } else {
+      const bool final = name.rfind("final_info/", 0) == 0;
+      const std::string field = name.substr(name.find('/') + 1);
+      int32_t count = 0;
+      const kage::InfoFieldDesc* fields = kage::info_fields(&count);
+      for (int32_t i = 0; i < count && !l.data; ++i) {
+        if (field != fields[i].name) continue;
+        l.data = final ? env().final_info(fields[i].field) : env().info(fields[i].field);
+        l.dtype = fields[i].dtype;
+      }
+      if (!l.data) raise_value_error("no output named '" + name + "'");
+    }
+    return l;
+  }
+
+  py::object export_array(const void* data, const std::vector<int64_t>& shape, kage::DType dtype) const {
+    if (env().backend() == kage::Backend::kGpu) return py::cast(DeviceArray(env_, data, shape, dtype));
+    // Host memory: a numpy view whose base keeps the batch alive.
+    auto* keep = new std::shared_ptr<kage::Env>(env_);
+    py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<kage::Env>*>(p); });
+    std::vector<py::ssize_t> strides(shape.size());
+    py::ssize_t stride = static_cast<py::ssize_t>(facts(dtype).bytes);
+    for (size_t i = shape.size(); i-- > 0;) {
+      strides[i] = stride;
+      stride *= shape[i];
+    }
+    return py::array(numpy_dtype(dtype), std::vector<py::ssize_t>(shape.begin(), shape.end()), strides, data, base);
+  }
+
+ public:
+
+  void reset(py::array_t<uint64_t, py::array::c_style | py::array::forcecast> seeds, const py::object& mask) {
+    check_length(seeds.size(), "seeds");
+    std::vector<uint8_t> m;
+    if (!mask.is_none()) {
+      auto a = mask.cast<py::array_t<uint8_t, py::array::c_style | py::array::forcecast>>();
+      check_length(a.size(), "mask");
+      m.assign(a.data(), a.data() + a.size());
+    }
+    std::string error;
+    bool ok;
+    {
+      py::gil_scoped_release release;
+      ok = env().reset(seeds.data(), m.empty() ? nullptr : m.data(), &error);
+    }
+    if (!ok) raise_step_error(error);
+  }
+
+  /// Host actions: int32 or int64, C-contiguous, num_envs values (checked by the Python side).
+  void step_host(const py::array& actions) {
+    const auto& dt = actions.dtype();
+    if ((dt.kind() != 'i') || (dt.itemsize() != 4 && dt.itemsize() != 8) || actions.ndim() != 1)
+      raise_value_error("internal: step_host wants a 1-D int32 or int64 array");
+    check_length(actions.size(), "actions");
+    const kage::Actions a{actions.data(), kage::Memory::kHost,
+                          dt.itemsize() == 8 ? kage::DType::kInt64 : kage::DType::kInt32,
+                          actions.strides(0) / dt.itemsize()};
+    run_step(a);
+  }
+
+  /// Device actions at `ptr` (int32 or int64, `stride` elements apart), produced on `producer_stream`
+  /// (a __cuda_array_interface__ stream number; -1: no ordering needed).
+  void step_device(uintptr_t ptr, bool is_int64, int64_t stride, int64_t producer_stream) {
+    if (env().backend() != kage::Backend::kGpu)
+      raise_value_error("actions are in GPU memory but the environment runs on the CPU: pass host actions "
+                        "(e.g. actions.cpu()) or make the environment with device='cuda'");
+    std::string error;
+    if (producer_stream != -1 &&
+        !kage::python::order_after(kage::python::protocol_stream(producer_stream), env().stream(), &error))
+      throw std::runtime_error(error);
+    run_step(kage::Actions{reinterpret_cast<const void*>(ptr), kage::Memory::kDevice,
+                           is_int64 ? kage::DType::kInt64 : kage::DType::kInt32, stride});
+  }
+
+  /// Device actions from a DLPack capsule (already ordered for this batch's stream by the producer's
+  /// __dlpack__(stream=...)). Shape [num_envs], int32 or int64, on CUDA device 0.
+  void step_dlpack(py::capsule capsule) {
+    auto* t = static_cast<DLManagedTensor*>(PyCapsule_GetPointer(capsule.ptr(), "dltensor"));
+    if (!t) throw py::error_already_set();
+    const DLTensor& d = t->dl_tensor;
+    std::string problem;
+    if (d.device.device_type != kDLCUDA)
+      problem = "a DLPack array on device type " + std::to_string(d.device.device_type);
+    else if (d.device.device_id != 0)
+      problem = "actions on cuda:" + std::to_string(d.device.device_id) + ", the environment runs on cuda:0";
+    else if (d.ndim != 1 || d.shape[0] != env().num_envs())
+      problem = "actions of shape " + shape_text(d) + ", expected (" + std::to_string(env().num_envs()) + ",)";
+    else if (d.dtype.lanes != 1 || d.dtype.code != kDLInt || (d.dtype.bits != 32 && d.dtype.bits != 64))
+      problem = "actions of DLPack type (code " + std::to_string(d.dtype.code) + ", " + std::to_string(d.dtype.bits) +
+                " bits), expected int32 or int64";
+    const kage::Actions a{static_cast<const char*>(d.data) + d.byte_offset, kage::Memory::kDevice,
+                          d.dtype.bits == 64 ? kage::DType::kInt64 : kage::DType::kInt32,
+                          d.strides ? d.strides[0] : 1};
+    // The consumer owns the tensor now: free it after the launch (the caller keeps the array alive).
+    PyCapsule_SetName(capsule.ptr(), "used_dltensor");
+    if (problem.empty()) {
+      try {
+        run_step(a);
+      } catch (...) {
+        if (t->deleter) t->deleter(t);
+        throw;
+      }
+    }
+    if (t->deleter) t->deleter(t);
+    if (!problem.empty()) raise_value_error(problem);
+  }
+
+  py::bytes save_state() const {
+    std::vector<uint8_t> out;
+    std::string error;
+    bool ok;
+    {
+      py::gil_scoped_release release;
+      ok = env().save_state(&out, &error);
+    }
+    if (!ok) throw std::runtime_error(error);
+    return py::bytes(reinterpret_cast<const char*>(out.data()), out.size());
+  }
+
+  void load_state(const py::bytes& data) {
+    const std::string_view view = data;
+    std::string error;
+    bool ok;
+    {
+      py::gil_scoped_release release;
+      ok = env().load_state(reinterpret_cast<const uint8_t*>(view.data()), view.size(), &error);
+    }
+    if (!ok) raise_value_error(error);
+  }
+
+  void synchronize() {
+    std::string error;
+    if (!env().synchronize(&error)) raise_step_error(error);
+  }
+  std::string pending_error() { return env().pending_error(); }
+
+  int32_t num_envs() const { return env().num_envs(); }
+  int32_t height() const { return env().height(); }
+  int32_t width() const { return env().width(); }
+  std::string spec_hash() const { return env().spec_hash(); }
+  std::string device() const { return env().backend() == kage::Backend::kGpu ? "cuda" : "cpu"; }
+  uintptr_t stream() const { return reinterpret_cast<uintptr_t>(env().stream()); }
+  void set_stream(uintptr_t s) { env().set_stream(reinterpret_cast<void*>(s)); }
+  void close() { env_.reset(); }
+  bool closed() const { return env_ == nullptr; }
+
+ private:
+  kage::Env& env() const {
+    if (!env_) throw std::runtime_error("this environment is closed: make a new one with kage.make_vec");
+    return *env_;
+  }
+
+  void check_length(py::ssize_t n, const char* what) const {
+    if (n != env().num_envs())
+      raise_value_error(std::string(what) + ": expected " + std::to_string(env().num_envs()) + " values (one per "
+                        "environment), got " + std::to_string(n));
+  }
+
+  static std::string shape_text(const DLTensor& d) {
+    std::string s = "(";
+    for (int32_t i = 0; i < d.ndim; ++i) s += std::to_string(d.shape[i]) + (d.ndim == 1 || i + 1 < d.ndim ? "," : "");
+    return s + ")";
+  }
+
+  /// A failed reset or step: an out-of-range action is a ValueError, anything else a RuntimeError.
+  static void raise_step_error(const std::string& error) {
+    if (error.find(kage::action_range_text()) != std::string::npos) raise_value_error(error);
+    throw std::runtime_error(error);
+  }
+
+  void run_step(const kage::Actions& a) {
+    std::string error;
+    bool ok;
+    {
+      py::gil_scoped_release release;
+      ok = env().step(a, &error);
+    }
+    if (!ok) raise_step_error(error);
+  }
+
+  std::shared_ptr<kage::Env> env_;
+};
+
+PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& device, int32_t num_threads,
+               const std::string& asset_root, uintptr_t stream) {
+  kage::Options o;
+  o.backend = device == "cuda" ? kage::Backend::kGpu : kage::Backend::kCpu;
+  o.num_envs = num_envs;
+  o.num_threads = num_threads;
+  o.asset_root = asset_root;
+  o.stream = reinterpret_cast<void*>(stream);
+  std::string error;
+  kage::ErrorKind kind = kage::ErrorKind::kOther;
+  std::unique_ptr<kage::Env> env;
+  {
+    py::gil_scoped_release release;
+    env = kage::open(path, o, &error, &kind);
+  }
+  if (env) return PyEnv(std::shared_ptr<kage::Env>(std::move(env)));
+  const OpenErrors& e = open_errors();
+  const py::object& cls = kind == kage::ErrorKind::kConfig   ? e.config
+                          : kind == kage::ErrorKind::kFile   ? e.file
+                          : kind == kage::ErrorKind::kDevice ? e.device
+                          : kind == kage::ErrorKind::kUsage  ? e.usage
+                                                             : e.other;
+  PyErr_SetObject(cls.ptr(), py::str(error).ptr());
+  throw py::error_already_set();
+}
+
+/// The JSON of a front-end call, or its diagnostics raised as the config error class.
+std::string front_end_json(const kage::python::FrontEndResult& r) {
+  if (r.ok()) return r.json;
+  PyErr_SetObject(open_errors().config.ptr(), py::str(r.error).ptr());
+  throw py::error_already_set();
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_kage, m) {
+  m.doc() = "Binding of the kage C++ API (include/kage/kage.h); use the kage package instead.";
+
+  // open() raises these, by failure kind; the kage package names them (kage.ConfigError, ...).
+  OpenErrors& e = open_errors();
+  e.config = py::reinterpret_borrow<py::object>(PyExc_ValueError);
+  e.file = py::reinterpret_borrow<py::object>(PyExc_FileNotFoundError);
+  e.device = py::reinterpret_borrow<py::object>(PyExc_RuntimeError);
+  e.usage = py::reinterpret_borrow<py::object>(PyExc_ValueError);
+  e.other = py::reinterpret_borrow<py::object>(PyExc_RuntimeError);
+  m.def(
+      "set_open_errors",
+      [](py::object config, py::object file, py::object device, py::object usage, py::object other) {
+        OpenErrors& e = open_errors();
+        e.config = std::move(config);
+        e.file = std::move(file);
+        e.device = std::move(device);
+        e.usage = std::move(usage);
+        e.other = std::move(other);
+      },
+      "Exception classes open() raises for a config, file, device, usage and any other error.");
+
+  m.def("gpu_backend_built", &kage::gpu_backend_built);
+  m.def("action_range_text", &kage::action_range_text, "The text in every error about an action outside 0..7.");
+  m.def("resolve", [](const std::string& path, const std::string& asset_root) {
+    return front_end_json(kage::python::resolve_config_json(path, asset_root));
+  }, py::arg("path"), py::arg("asset_root") = "", "kagec resolve: the canonical Spec as JSON text.");
+  m.def("certify", [](const std::string& train, const std::string& eval, const std::string& asset_root) {
+    return front_end_json(kage::python::certify_pair_json(train, eval, asset_root));
+  }, py::arg("train"), py::arg("eval"), py::arg("asset_root") = "",
+     "kagec diff --certify: the pair's certificate as JSON text.");
+  m.def("suite_report", [](const std::string& manifest) {
+    return front_end_json(kage::python::suite_report(manifest));
+  }, py::arg("manifest"), "kagec suite: the report of a manifest (pairs, sweeps, certificates) as JSON text.");
+  m.def("info_fields", [] {
+    int32_t count = 0;
+    const kage::InfoFieldDesc* fields = kage::info_fields(&count);
+    py::list out;
+    for (int32_t i = 0; i < count; ++i) out.append(py::make_tuple(fields[i].name, numpy_dtype(fields[i].dtype), fields[i].doc));
+    return out;
+  }, "(name, numpy dtype, meaning) of every info field, in order.");
+  m.def("open", &open_env, py::arg("path"), py::arg("num_envs"), py::arg("device"), py::arg("num_threads"),
+        py::arg("asset_root"), py::arg("stream"));
+
+  py::class_<DeviceArray>(m, "DeviceArray",
+                          "A [N, ...] array in GPU memory, owned by an environment: take it with "
+                          "torch.from_dlpack, jax.dlpack.from_dlpack or cupy.asarray (no copy), or copy it "
+                          "to the host with .numpy(). Valid until the environment's next reset or step.")
+      .def("__dlpack__", [](const DeviceArray& a, py::object stream, py::object, py::object, py::object) {
+             return a.dlpack(stream);
+           }, py::kw_only(), py::arg("stream") = py::none(), py::arg("max_version") = py::none(),
+           py::arg("dl_device") = py::none(), py::arg("copy") = py::none())
+      .def("__dlpack_device__", [](const DeviceArray&) { return py::make_tuple(static_cast<int>(kDLCUDA), 0); })
+      .def_property_readonly("__cuda_array_interface__", &DeviceArray::cuda_array_interface)
+      .def_property_readonly("shape", &DeviceArray::shape)
+      .def_property_readonly("dtype", &DeviceArray::dtype)
+      .def_property_readonly("data_ptr", &DeviceArray::data_ptr)
+      .def_property_readonly("device", [](const DeviceArray&) { return "cuda:0"; })
+      .def("numpy", &DeviceArray::numpy, "A host copy (waits for the environment's queued work).")
+      .def("__repr__", [](const DeviceArray& a) {
+        return "DeviceArray(shape=" + py::str(a.shape()).cast<std::string>() + ", dtype=" +
+               py::str(a.dtype()).cast<std::string>() + ", device='cuda:0')";
+      });
+
+  py::class_<PyEnv>(m, "Env")
+      .def("output", &PyEnv::output)
+      .def("data_ptr", &PyEnv::data_ptr)
+      .def("reset", &PyEnv::reset, py::arg("seeds"), py::arg("mask") = py::none())
+      .def("step_host", &PyEnv::step_host)
+      .def("step_device", &PyEnv::step_device)
+      .def("step_dlpack", &PyEnv::step_dlpack)
+      .def("save_state", &PyEnv::save_state)
+      .def("load_state", &PyEnv::load_state)
+      .def("synchronize", &PyEnv::synchronize)
+      .def("pending_error", &PyEnv::pending_error)
+      .def("close", &PyEnv::close)
+      .def_property_readonly("closed", &PyEnv::closed)
+      .def_property_readonly("num_envs", &PyEnv::num_envs)
+      .def_property_readonly("height", &PyEnv::height)
+      .def_property_readonly("width", &PyEnv::width)
+      .def_property_readonly("spec_hash", &PyEnv::spec_hash)
+      .def_property_readonly("device", &PyEnv::device)
+      .def_property("stream", &PyEnv::stream, &PyEnv::set_stream);
+}

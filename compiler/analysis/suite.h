@@ -1,0 +1,74 @@
+// Suites: manifests of train/eval pairs (and sweeps: one train, several evals),
+// each linted, resolved, diffed and certified against its declared axis.
+#pragma once
+
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "compiler/analysis/diff.h"
+#include "compiler/basic/diag.h"
+#include "compiler/parse/yaml_doc.h"
+#include "compiler/sema/resolve.h"
+
+namespace kage {
+
+/// One side of a pair: a config file, or a config written inline in the manifest.
+struct ConfigRef {
+  std::string path;              // set for a file
+  std::optional<DocNode> inline_doc;  // set for an inline config
+  std::string label() const;
+};
+
+struct SuitePair {
+  std::string name;
+  std::string sweep;       // the sweep this pair belongs to (empty for a plain pair)
+  std::string sweep_eval;  // its eval's name within the sweep
+  Axis axis = Axis::Background;
+  ConfigRef train, eval;
+  std::vector<Allowance> allow;
+  Range range;  // where the pair is written
+};
+
+struct Suite {
+  std::string name;
+  std::string description;
+  std::string manifest;  // path
+  std::string dir;       // for relative paths
+  FileId file = kNoFile;
+  std::vector<SuitePair> pairs;  // sweeps expanded into pairs
+};
+
+/// The file name of a pair's certificate under DIR/certificates/ ('/' and spaces become '_').
+std::string certificate_file_name(const std::string& pair_name);
+
+/// Reads a manifest; structural errors go to diags.
+std::optional<Suite> load_suite(const std::string& path, SourceManager& sources, FileReader& reader,
+                                DiagEngine& diags);
+
+struct PairResult {
+  const SuitePair* pair = nullptr;
+  bool lint_ok = false;        // both sides resolved without errors
+  size_t warnings = 0;
+  std::optional<Spec> train, eval;
+  SpecDiff diff;
+  Certification cert;
+  bool passed() const { return lint_ok && cert.certified; }
+};
+
+struct SuiteReport {
+  std::vector<PairResult> results;
+  size_t passed() const;
+};
+
+/// Lints and certifies every pair; `progress` (may be null) receives one line per pair.
+SuiteReport run_suite(const Suite& suite, const ResolveOptions& options, SourceManager& sources, FileReader& reader,
+                      DiagEngine& diags, std::ostream* progress);
+
+/// One row per pair: pair, declared axis, measured axes, verdict.
+void print_suite_table(const Suite& suite, const SuiteReport& report, std::ostream& out);
+/// The JSON report, with a certificate per pair.
+Json suite_report_json(const Suite& suite, const SuiteReport& report);
+
+}  // namespace kage

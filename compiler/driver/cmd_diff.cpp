@@ -1,0 +1,90 @@
+// kagec diff TRAIN EVAL [--certify] [--axis AXIS | --certify=AXIS] [-o CERT.json].
+#include <ostream>
+
+#include "compiler/analysis/diff.h"
+#include "compiler/basic/file_out.h"
+#include "compiler/driver/cli_common.h"
+
+namespace kage {
+namespace {
+
+// `--certify=AXIS` is `--certify --axis AXIS`. The axis never follows `--certify` as a separate word,
+// which would make it indistinguishable from the TRAIN file.
+std::vector<std::string> split_certify_axis(const std::vector<std::string>& args) {
+  std::vector<std::string> out;
+  for (const std::string& a : args) {
+    if (a.rfind("--certify=", 0) == 0) {
+      out.insert(out.end(), {"--certify", "--axis", a.substr(10)});
+    } else {
+      out.push_back(a);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+int cmd_diff(const std::vector<std::string>& args, CommandIo& io) {
+  CLI::App app("List the effective differences of a train/eval pair, grouped by axis.", "diff");
+  std::vector<std::string> files;
+  std::string output, certify_axis;
+  bool certify_flag = false;
+  DiagOptions opts;
+  app.add_option("files", files, "TRAIN EVAL: the two configs")->required()->expected(2, 3);
+  app.add_flag("--certify", certify_flag,
+               "exit 0 only if exactly one visual axis changes and nothing latent (--certify=AXIS names the axis)");
+  app.add_option("--axis", certify_axis, "certify, requiring that the changing axis is this one");
+  app.add_option("-o,--output", output, "write the JSON certificate to this file");
+  opts.add_to(app, false);
+  if (auto code = parse_args(app, split_certify_axis(args), io)) return *code;
+  if (files.size() != 2) {
+    io.err << "kagec diff: expected two configs (TRAIN EVAL), got " << files.size()
+           << "; an axis to certify is written --axis " << files[0] << " or --certify=" << files[0]
+           << " (also after the files)\n";
+    return kExitUsage;
+  }
+  const std::string& train_file = files[0];
+  const std::string& eval_file = files[1];
+  std::optional<Axis> declared;
+  if (!certify_axis.empty()) {
+    declared = parse_axis(certify_axis);
+    if (!declared || *declared == Axis::Latent) {
+      io.err << "kagec diff: unknown axis '" << certify_axis
+             << "'; use background, agent, distractors, filters, effects or layout\n";
+      return kExitUsage;
+    }
+  }
+  SourceManager sources;
+  DiagEngine diags(sources);
+  if (!opts.apply(diags, io)) return kExitUsage;
+  DiskFileReader reader;
+  const auto train = analyze_file(train_file, opts.resolve_options(), sources, reader, diags);
+  const auto eval = analyze_file(eval_file, opts.resolve_options(), sources, reader, diags);
+  print_text(diags, io.err, io.err_is_terminal);
+  if (!train || !eval || diags.has_errors()) {
+    io.err << "kagec diff: fix the errors above first\n";
+    return kExitErrors;
+  }
+  const SpecDiff diff = diff_specs(*train, *eval, config_schema());
+  print_diff(diff, io.out);
+  const bool certifying = certify_flag || !certify_axis.empty();
+  const Certification cert = certify(diff, declared, {});
+  if (!output.empty()) {
+    std::string error;
+    if (!write_file(output,
+                    json_file_text(certificate_json({train_file, train->sha256()}, {eval_file, eval->sha256()}, diff, cert)),
+                    &error)) {
+      io.err << "kagec diff: " << error << '\n';
+      return kExitErrors;
+    }
+  }
+  if (!certifying) return kExitOk;
+  if (cert.certified) {
+    io.out << "certified: exactly one visual axis changes (" << axes_text(cert.measured) << "), nothing latent\n";
+    return kExitOk;
+  }
+  for (const std::string& p : cert.problems) io.out << "not certified: " << p << '\n';
+  return kExitErrors;
+}
+
+}  // namespace kage

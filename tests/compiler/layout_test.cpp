@@ -1,0 +1,79 @@
+// The dependency rules of docs/architecture.md, checked on the #include lines of the source tree:
+// the front end's early stages stay clear of the runtime's simulation, only the driver reaches the
+// verification code, and no source includes bench/ (but the GPU benchmark's CPU reference, still there).
+#include <catch2/catch.hpp>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "test_support.h"
+
+namespace kage::test {
+namespace {
+
+/// Every `#include "..."` of the C++ files under `dir`, as "file:line: path".
+std::vector<std::pair<std::string, std::string>> project_includes(const std::string& dir) {
+  static const std::regex include(R"re(^\s*#\s*include\s+"([^"]+)")re");
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& e : fs::recursive_directory_iterator(source_dir() / dir)) {
+    const std::string ext = e.path().extension().string();
+    if (!e.is_regular_file() || (ext != ".cpp" && ext != ".h" && ext != ".cu" && ext != ".cuh")) continue;
+    std::istringstream in(read_text(e.path()));
+    std::string line;
+    for (int n = 1; std::getline(in, line); ++n) {
+      std::smatch m;
+      if (std::regex_search(line, m, include))
+        out.emplace_back(fs::relative(e.path(), source_dir()).generic_string() + ":" + std::to_string(n), m[1]);
+    }
+  }
+  return out;
+}
+
+bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+}  // namespace
+
+TEST_CASE("basic, parse, sema and analysis include no runtime code but asset and image I/O",
+          "[layout][one-source-of-truth]") {
+  // sema lists, measures and hashes asset files; it never sees the simulation.
+  const std::set<std::string> io_headers = {"asset_scan.h", "image_io.h", "sha256.h"};
+  size_t seen = 0;
+  std::vector<std::string> offenders;
+  for (const char* dir : {"compiler/basic", "compiler/parse", "compiler/sema", "compiler/analysis"}) {
+    for (const auto& [where, path] : project_includes(dir)) {
+      ++seen;
+      if (!starts_with(path, "runtime/")) continue;
+      const std::string file = fs::path(path).filename().string();
+      const std::string folder = fs::path(path).parent_path().generic_string();
+      if (folder == "runtime/io" && io_headers.count(file)) continue;
+      offenders.push_back(where + ": " + path);
+    }
+  }
+  std::string report;
+  for (const std::string& o : offenders) report += o + "\n";
+  INFO("includes of the runtime from the front end's early stages:\n" << report);
+  CHECK(seen > 50);  // the scan found the stages' own includes
+  CHECK(offenders.empty());
+}
+
+TEST_CASE("only the driver includes verify/, and nothing includes bench/", "[layout]") {
+  size_t seen = 0;
+  std::vector<std::string> offenders;
+  for (const char* dir : {"compiler", "api", "runtime", "verify"}) {
+    for (const auto& [where, path] : project_includes(dir)) {
+      ++seen;
+      const bool in_verify = starts_with(where, "verify/");
+      const bool in_driver = starts_with(where, "compiler/driver/");
+      if (starts_with(path, "verify/") && !in_verify && !in_driver) offenders.push_back(where + ": " + path);
+      if (starts_with(path, "bench/")) offenders.push_back(where + ": " + path);
+    }
+  }
+  std::string report;
+  for (const std::string& o : offenders) report += o + "\n";
+  INFO("includes against the layout's rules:\n" << report);
+  CHECK(seen > 200);
+  CHECK(offenders.empty());
+}
+
+}  // namespace kage::test
