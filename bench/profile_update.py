@@ -5,10 +5,10 @@ top CUDA kernels of the first variant. Picks the flags before a full `kage.bench
 usage: python3 bench/profile_update.py [--packs 16] [--minibatch 2048] [--profile]
 """
 import argparse
-import statistics
 
 import torch
 
+from cuda_timing import median_ms
 from kage.agent import Agent
 
 VARIANTS = [  # (bf16, channels_last, fused_input, triton_conv)
@@ -35,23 +35,14 @@ def minibatch_ms(k: int, minibatch: int, bf16: bool, channels_last: bool, fused:
         loss.backward()
         optimizer.step()
 
-    for _ in range(3):
-        step()
-    times = []
-    for _ in range(5):
-        start, end = torch.cuda.Event(enable_timing=True), torch.cuda.Event(enable_timing=True)
-        start.record()
-        step()
-        end.record()
-        torch.cuda.synchronize()
-        times.append(start.elapsed_time(end))
+    ms = median_ms(step)
     if profile:
         from torch.profiler import ProfilerActivity
         with torch.profiler.profile(activities=[ProfilerActivity.CUDA]) as prof:
             step()
             torch.cuda.synchronize()
         print(prof.key_averages().table(sort_by="cuda_time_total", row_limit=12, max_name_column_width=70))
-    return statistics.median(times)
+    return ms
 
 
 def main() -> None:

@@ -11,12 +11,13 @@ mantissa). The bf16 checks allow 2e-2 (outputs rounded to bf16). Errors are max 
 import argparse
 import importlib.util
 import pathlib
-import statistics
 import sys
 
 import torch
 import torch.nn.functional as F
 import triton
+
+from cuda_timing import median_ms
 
 _SPEC = importlib.util.spec_from_file_location(
     "triton_conv", pathlib.Path(__file__).resolve().parent.parent / "python" / "kage" / "triton_conv.py")
@@ -61,20 +62,6 @@ def check_layer(k: int, b: int, layer, dtype: torch.dtype, tolerance: float) -> 
         print(f"K = {k}, B = {b}, {str(dtype)[6:]}, {name} {quantity}: max relative error {error:.2e} "
               f"(tolerance {tolerance:.0e}, {str(g.dtype)[6:]}) {'PASS' if ok else 'FAIL'}", flush=True)
     return failures
-
-
-def median_ms(step, warmup: int = 3, repeats: int = 5) -> float:
-    for _ in range(warmup):
-        step()
-    times = []
-    for _ in range(repeats):
-        start, end = torch.cuda.Event(enable_timing=True), torch.cuda.Event(enable_timing=True)
-        start.record()
-        step()
-        end.record()
-        torch.cuda.synchronize()
-        times.append(start.elapsed_time(end))
-    return statistics.median(times)
 
 
 def torso_steps(k: int, b: int):
