@@ -21,17 +21,17 @@ after=$PWD/$BUILD/kagec
 if [[ $STEPS == *bench* ]]; then
 (cd .before && ln -sfn ../.deps .deps && OUT=$OUT/before source bench/device_build.sh >/dev/null) ||
   { echo "the .before tree did not build: $OUT/before/build.log"; exit 1; }
-before=$PWD/.before/$BUILD/kagec
 
-bench() {  # kagec CONFIG -> the row's steps/s with observations
-  "$1" bench "$2" --gpu --min-log2 "$LOG2" --max-log2 "$LOG2" 2>>"$OUT/bench.err" | awk -F'|' '/^\| configs/ {print $4}'
+bench() {  # TREE CONFIG -> the row's steps/s with observations, of TREE's kagec with TREE's runtime headers
+  (cd "$1" && KAGE_ROOT=$PWD KAGE_CACHE_DIR=$PWD/.kage-cache "$PWD/$BUILD/kagec" bench "$2" --gpu \
+    --min-log2 "$LOG2" --max-log2 "$LOG2" 2>>"$OUT/bench.err") | awk -F'|' '/^\| configs/ {print $4}'
 }
-for config in $CONFIGS; do bench "$before" "$config" >/dev/null; bench "$after" "$config" >/dev/null; done
+declare -A tree=([before]=$PWD/.before [after]=$PWD)
+for config in $CONFIGS; do bench "${tree[before]}" "$config" >/dev/null; bench "${tree[after]}" "$config" >/dev/null; done
 for round in $(seq "$ROUNDS"); do
   for config in $CONFIGS; do
     for build in before after; do
-      kagec=$before; [ "$build" = after ] && kagec=$after
-      echo "$round $config $build $(bench "$kagec" "$config")" | tee -a "$OUT/rounds.txt"
+      echo "$round $config $build $(bench "${tree[$build]}" "$config")" | tee -a "$OUT/rounds.txt"
     done
   done
 done

@@ -1,6 +1,6 @@
 // The dependency rules of docs/architecture.md, checked on the #include lines of the source tree:
 // the front end's early stages stay clear of the runtime's simulation, only the driver reaches the
-// verification code, and no source includes bench/ (but the GPU benchmark's CPU reference, still there).
+// verification code, and no source includes bench/.
 #include <catch2/catch.hpp>
 #include <regex>
 #include <set>

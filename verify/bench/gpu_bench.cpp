@@ -1,4 +1,4 @@
-// kage_gpu_bench: correctness (GPU vs CPU reference), load times and throughput of the CUDA runtime
+// kage_gpu_bench: correctness (GPU vs CPU batch), load times and throughput of the CUDA runtime
 // for configs compiled by `kagec compile`, against a device-to-device copy roofline measured in the
 // same run, and the device's FP32 rate (fp32_peak.fatbin beside GENERIC_FATBIN).
 //
@@ -9,7 +9,7 @@
 // through compiler/codegen/compiled_dir.h), named after its last path component;
 // --breakdown needs one named "hardest". With --nvrtc-root (the directory holding runtime/), the
 // generated source is also compiled with NVRTC, cold (empty cache) and warm (disk cache hit).
-// --check-only checks every DIR through the generic build against the CPU reference (observations
+// --check-only checks every DIR through the generic build against the CPU batch (observations
 // within 1 code) and stops: DIRs need only params.bin and assets.bin (kagec compile --no-gpu), so all
 // shipped configs can be checked without building a fatbin for each.
 #include <algorithm>
@@ -164,7 +164,7 @@ std::vector<std::pair<std::string, VisualParams>> breakdown_variants(const Visua
 /// build must match the CPU on every shipped config, not only on the two timed ones). Returns the
 /// exit status.
 int check_only(const CudaModule& dynamic, const std::vector<BenchDir>& dirs, int32_t envs) {
-  std::printf("## Generic build vs CPU reference, every config (%d envs, episode length + 5 steps)\n\n"
+  std::printf("## Generic build vs CPU batch, every config (%d envs, episode length + 5 steps)\n\n"
               "| config | episode length | steps | state mismatches | obs max diff | obs equal %% | result |\n"
               "|---|---|---|---|---|---|---|\n", envs);
   int32_t passed = 0;
@@ -267,7 +267,7 @@ int run(int argc, char** argv) {
   for (size_t i = 0; i < compiled.size(); ++i)
     cfgs.push_back({{&modules[i], compiled[i].lp, compiled[i].vp, compiled[i].assets()}, compiled[i].name});
 
-  std::printf("\n## Correctness (GPU vs CPU reference, %d envs, episode length + 5 steps)\n\n", check_envs);
+  std::printf("\n## Correctness (GPU vs CPU batch, %d envs, episode length + 5 steps)\n\n", check_envs);
   for (const Config& c : skip_checks ? std::vector<Config>{} : cfgs) {
     // Identical frames expected: the transcendentals are IEEE-only (kage_math.h), so the noise
     // samplers draw the same samples on both sides.
