@@ -14,7 +14,7 @@
 #include "compiler/basic/internal_error.h"
 #include "compiler/codegen/build.h"
 #include "compiler/lower/lower.h"
-#include "runtime/io/sha256.h"
+#include "fileio/sha256.h"
 
 namespace kage {
 

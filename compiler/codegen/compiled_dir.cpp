@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "compiler/basic/file_out.h"
-#include "runtime/io/sha256.h"
+#include "fileio/sha256.h"
 #include "runtime/io/specialized_assets.h"
 
 namespace kage {

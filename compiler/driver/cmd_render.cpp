@@ -10,7 +10,7 @@
 #include "api/environment.h"
 #include "compiler/driver/cli_common.h"
 #include "runtime/io/gif_writer.h"
-#include "runtime/io/image_io.h"
+#include "fileio/image_io.h"
 #include "runtime/rng.h"
 
 namespace kage {

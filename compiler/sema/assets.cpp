@@ -11,9 +11,9 @@
 
 #include "compiler/basic/utf8.h"
 #include "compiler/sema/key_refs.h"
-#include "runtime/io/asset_scan.h"
-#include "runtime/io/image_io.h"
-#include "runtime/io/sha256.h"
+#include "fileio/asset_scan.h"
+#include "fileio/image_io.h"
+#include "fileio/sha256.h"
 
 namespace kage {
 

@@ -1,7 +1,7 @@
 // Spec: canonical JSON and hashing.
 #include "compiler/sema/spec.h"
 
-#include "runtime/io/sha256.h"
+#include "fileio/sha256.h"
 
 namespace kage {
 

@@ -11,7 +11,7 @@
 #include <random>
 #include <sstream>
 
-#include "runtime/io/sha256.h"
+#include "fileio/sha256.h"
 
 namespace kage {
 namespace {

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <filesystem>
 
-#include "runtime/io/asset_scan.h"
-#include "runtime/io/image_io.h"
+#include "fileio/asset_scan.h"
+#include "fileio/image_io.h"
 
 namespace kage {
 namespace {

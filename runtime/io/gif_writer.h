@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/io/image_io.h"
+#include "fileio/image_io.h"
 
 namespace kage {
 

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "compiler/driver/commands.h"
-#include "runtime/io/image_io.h"
+#include "fileio/image_io.h"
 #include "tests/integration/integration_support.h"
 
 namespace {

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "runtime/io/asset_pack.h"
-#include "runtime/io/asset_scan.h"
-#include "runtime/io/image_io.h"
+#include "fileio/asset_scan.h"
+#include "fileio/image_io.h"
 #include "tests/skip.h"
 
 namespace {

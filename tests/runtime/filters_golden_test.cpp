@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/io/image_io.h"
+#include "fileio/image_io.h"
 #include "tests/runtime/golden_image_support.h"
 #include "runtime/visual/filters.h"
 #include "runtime/visual/image_diff.h"

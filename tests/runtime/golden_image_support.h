@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 #include <string>
 
-#include "runtime/io/image_io.h"
+#include "fileio/image_io.h"
 
 namespace kage::test {
 

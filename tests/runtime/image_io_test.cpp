@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "runtime/io/gif_writer.h"
-#include "runtime/io/image_io.h"
+#include "fileio/image_io.h"
 
 namespace {
 

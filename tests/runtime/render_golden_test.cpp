@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "runtime/io/asset_pack.h"
-#include "runtime/io/image_io.h"
+#include "fileio/image_io.h"
 #include "runtime/visual/image_diff.h"
 #include "runtime/visual/render.h"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/io/image_io.h"
+#include "fileio/image_io.h"
 #include "runtime/latent/latent_params.h"
 #include "runtime/visual/asset_view.h"
 #include "runtime/visual/image_diff.h"

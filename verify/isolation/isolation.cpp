@@ -6,7 +6,7 @@
 #include "api/environment.h"
 #include "compiler/codegen/codegen.h"
 #include "compiler/lower/lower.h"
-#include "runtime/io/sha256.h"
+#include "fileio/sha256.h"
 
 namespace kage {
 

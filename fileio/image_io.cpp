@@ -1,6 +1,6 @@
 // Host image I/O over stb_image / stb_image_write, plus a bit-faithful port of
 // Pillow's 8-bit Lanczos resampler (libImaging/Resample.c).
-#include "runtime/io/image_io.h"
+#include "fileio/image_io.h"
 
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>

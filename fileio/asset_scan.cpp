@@ -1,6 +1,6 @@
 // Directory scanning for backgrounds and sprite skins, reproducing pathlib's
 // glob/rglob + sorted() as used by the original environment constructor.
-#include "runtime/io/asset_scan.h"
+#include "fileio/asset_scan.h"
 
 #include <algorithm>
 #include <filesystem>
