@@ -1,4 +1,4 @@
-// Tests for runtime/io image I/O: decoding errors, PNG round trip, the GIF
+// Tests for fileio/ image I/O and the runtime/io GIF writer: decoding errors, PNG round trip, the GIF
 // encoder (decoded back with stb_image) and the Lanczos resampler.
 #include <catch2/catch.hpp>
 #include <stb/stb_image.h>
