@@ -1,7 +1,7 @@
 """Checks python/kage/triton_conv.py's packed convolutions (Triton implicit-GEMM kernels, the run as a grid
 axis) against cuDNN's grouped convolutions and times them on the NatureCNN torso against cuDNN in
 channels-last bf16, the trainer's fastest variant. Needs torch with CUDA and triton only: the module is
-loaded from its file, not through the kage package (which needs the C++ build).
+imported without the kage package's __init__ (which loads the C++ extension).
 
 usage: python3 bench/triton_conv_check.py [--profile]
 
@@ -9,9 +9,9 @@ Exits non-zero if any check fails. The fp32 checks allow 1e-3: tl.dot rounds fp3
 mantissa). The bf16 checks allow 2e-2 (outputs rounded to bf16). Errors are max |got - want| / max |want|.
 """
 import argparse
-import importlib.util
 import pathlib
 import sys
+import types
 
 import torch
 import torch.nn.functional as F
@@ -19,10 +19,12 @@ import triton
 
 from cuda_timing import median_ms
 
-_SPEC = importlib.util.spec_from_file_location(
-    "triton_conv", pathlib.Path(__file__).resolve().parent.parent / "python" / "kage" / "triton_conv.py")
-tc = importlib.util.module_from_spec(_SPEC)
-_SPEC.loader.exec_module(tc)
+# The kage package without its __init__ (which loads the C++ extension): its modules import as usual.
+_KAGE = types.ModuleType("kage")
+_KAGE.__path__ = [str(pathlib.Path(__file__).resolve().parent.parent / "python" / "kage")]
+sys.modules["kage"] = _KAGE
+from kage import space_to_depth as s2d  # noqa: E402
+from kage import triton_conv as tc  # noqa: E402
 
 # NatureCNN's convolutions on 128 x 128 x 3 frames: (name, input side, in channels, out channels, kernel, stride).
 LAYERS = [("conv1", 128, 3, 32, 8, 4), ("conv2", 31, 32, 64, 4, 2), ("conv3", 14, 64, 64, 3, 1)]
@@ -78,7 +80,7 @@ def torso_steps(k: int, b: int):
 
     def triton_step():
         with torch.autocast("cuda", dtype=torch.bfloat16):
-            x = F.relu(tc.packed_conv(frames, tc.weight_space_to_depth(convs[0].weight, 4), convs[0].bias))
+            x = F.relu(tc.packed_conv(frames, s2d.weight_space_to_depth(convs[0].weight, 4), convs[0].bias))
             x = F.relu(tc.packed_conv(x, convs[1].weight, convs[1].bias, 2))
             x = F.relu(tc.packed_conv(x, convs[2].weight, convs[2].bias))
             loss = x.sum()
@@ -88,7 +90,7 @@ def torso_steps(k: int, b: int):
 
     def cudnn_step():
         with torch.autocast("cuda", dtype=torch.bfloat16):
-            w1 = tc.weight_space_to_depth(cl_convs[0].weight, 4).contiguous(memory_format=torch.channels_last)
+            w1 = s2d.weight_space_to_depth(cl_convs[0].weight, 4).contiguous(memory_format=torch.channels_last)
             x = F.relu(F.conv2d(cl_frames, w1, cl_convs[0].bias, groups=k))
             x = F.relu(cl_convs[1](x))
             x = F.relu(cl_convs[2](x))

@@ -9,6 +9,8 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
+from kage.space_to_depth import space_to_depth, weight_space_to_depth
+
 
 def autocast(bf16: bool):
     """bfloat16 autocast for the network under --bf16, else nothing."""
@@ -106,8 +108,7 @@ class Agent(nn.Module):
         h, w = h // 4 * 4, w // 4 * 4  # rows and columns past the last whole block are never read
         blocks = obs[:, :, :h, :w].reshape(k, b, h // 4, 4, w // 4, 4, c).permute(1, 2, 4, 0, 6, 3, 5)
         x = self._input(blocks.reshape(b, h // 4, w // 4, k * c * 16))
-        weight = self.conv1.weight  # [K*32, C, 8, 8] = [K*32, C, (a, p), (b, q)]
-        weight = weight.view(-1, c, 2, 4, 2, 4).permute(0, 1, 3, 5, 2, 4).reshape(-1, c * 16, 2, 2)
+        weight = weight_space_to_depth(self.conv1.weight, 4)
         if self.conv1.weight.is_contiguous(memory_format=torch.channels_last):
             weight = weight.contiguous(memory_format=torch.channels_last)
         return F.conv2d(x, weight, self.conv1.bias, stride=1, groups=k)
@@ -118,9 +119,8 @@ class Agent(nn.Module):
         into 4x4 blocks as under --fused-input. Returns [K, B, flat] in each run's (channel, row, column) order."""
         from kage import triton_conv  # here, not at the top: triton is needed only under the flag
         k, b = obs.shape[:2]
-        x = triton_conv.space_to_depth(obs, 4, self.input_dtype).div_(255.0)
-        x = F.relu(triton_conv.packed_conv(x, triton_conv.weight_space_to_depth(self.conv1.weight, 4),
-                                           self.conv1.bias))
+        x = space_to_depth(obs, 4, self.input_dtype).div_(255.0)
+        x = F.relu(triton_conv.packed_conv(x, weight_space_to_depth(self.conv1.weight, 4), self.conv1.bias))
         x = F.relu(triton_conv.packed_conv(x, self.conv2.weight, self.conv2.bias, stride=2))
         x = F.relu(triton_conv.packed_conv(x, self.conv3.weight, self.conv3.bias))
         return x.permute(0, 1, 4, 2, 3).reshape(k, b, self.flat)

@@ -6,11 +6,11 @@ moved more bytes than it saved: bench/results/2026-11-23-h100-packed-training-sp
 same. Imported only under --triton-conv: triton is a GPU-machine dependency. Checked and timed by
 bench/triton_conv_check.py.
 """
-from typing import Optional
-
 import torch
 import triton
 import triton.language as tl
+
+from kage.space_to_depth import space_to_depth, weight_space_to_depth
 
 # Channel counts are 48/128/64 in (after space-to-depth) and 32/64/64 out; a program's output tile covers
 # the whole output width (BLOCK_N) in the forward pass and the weight gradient, so the configs tune the rest.
@@ -222,28 +222,6 @@ class _PackedConvStride1(torch.autograd.Function):
         if ctx.needs_input_grad[2]:
             db = dy.sum(dim=(1, 2, 3), dtype=torch.float32).reshape(-1).to(ctx.bias_dtype)
         return dx, dw, db
-
-
-def space_to_depth(x: torch.Tensor, s: int, dtype: Optional[torch.dtype] = None) -> torch.Tensor:
-    """[K, B, H, W, C] -> [K, B, H // s, W // s, C * s * s], channel (c, p, q) of block (i, j) holding
-    x[.., s * i + p, s * j + q, c] (the trainer's fused-input order); rows and columns past the last whole
-    block are dropped (a stride-s convolution whose kernel is a multiple of s never reads them). A dtype
-    converts in the same copy (uint8 frames)."""
-    k, b, h, w, c = x.shape
-    h, w = h // s * s, w // s * s
-    blocks = x[:, :, :h, :w].reshape(k, b, h // s, s, w // s, s, c).permute(0, 1, 2, 4, 6, 3, 5)
-    if dtype is not None:
-        blocks = blocks.to(dtype, memory_format=torch.contiguous_format)
-    return blocks.reshape(k, b, h // s, w // s, c * s * s)
-
-
-def weight_space_to_depth(weight: torch.Tensor, s: int) -> torch.Tensor:
-    """The grouped layout's weight [K * Cout, C, kh, kw] -> [K * Cout, C * s * s, kh // s, kw // s] for
-    space_to_depth's input: filter row s * a + p, column s * b + q meets channel (c, p, q) at offset (a, b)."""
-    o, c, kh, kw = weight.shape
-    assert kh % s == 0 and kw % s == 0, (weight.shape, s)
-    blocks = weight.reshape(o, c, kh // s, s, kw // s, s).permute(0, 1, 3, 5, 2, 4)
-    return blocks.reshape(o, c * s * s, kh // s, kw // s)
 
 
 def packed_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int = 1) -> torch.Tensor:
