@@ -59,19 +59,31 @@ const void* info_column(const Table& t, InfoField field) {
   return nullptr;
 }
 
-/// Host actions as int32, checked to be in 0..7; the reason when they are not.
-std::string host_actions(const Actions& a, int32_t n, std::vector<int32_t>* out) {
-  if (a.dtype != DType::kInt32 && a.dtype != DType::kInt64) return "actions must be int32 or int64";
+/// Host actions as int32, checked to be in 0..7; the reason when they are not, and its kind in `kind`.
+std::string host_actions(const Actions& a, int32_t n, std::vector<int32_t>* out, ErrorKind* kind) {
+  if (a.dtype != DType::kInt32 && a.dtype != DType::kInt64) {
+    *kind = ErrorKind::kOther;
+    return "actions must be int32 or int64";
+  }
   out->resize(static_cast<size_t>(n));
   for (int32_t i = 0; i < n; ++i) {
     const int64_t at = static_cast<int64_t>(i) * a.stride;
     const int64_t v = a.dtype == DType::kInt64 ? static_cast<const int64_t*>(a.data)[at]
                                                : static_cast<const int32_t*>(a.data)[at];
-    if (v < 0 || v > 7)
+    if (v < 0 || v > 7) {
+      *kind = ErrorKind::kAction;
       return "action " + std::to_string(v) + " for environment " + std::to_string(i) + ": " + action_range_text();
+    }
     (*out)[static_cast<size_t>(i)] = static_cast<int32_t>(v);
   }
   return {};
+}
+
+/// host_actions for a step: false with the message in `error` and the failure's kind in `kind` (kAction for
+/// a value outside 0..7, kOther for a wrong dtype).
+bool checked_host_actions(const Actions& a, int32_t n, std::vector<int32_t>* out, ErrorKind* kind, std::string* error) {
+  const std::string problem = host_actions(a, n, out, kind);
+  return problem.empty() || fail(error, "kage: " + problem);
 }
 
 /// A lowered config with its Spec hash, from a YAML file or a compiled dir's params.bin.
@@ -110,12 +122,14 @@ class HostEnv final : public Env {
     if (lib_) ::dlclose(lib_);
   }
   bool reset(const uint64_t* seeds, const uint8_t* mask, std::string*) override {
+    last_error_kind_ = ErrorKind::kNone;
     return batch_.reset(seeds, mask), true;
   }
   bool step(const Actions& a, std::string* e) override {
+    last_error_kind_ = ErrorKind::kOther;
     if (a.memory != Memory::kHost) return fail(e, "kage: device actions given to a CPU environment: pass host memory");
-    const std::string problem = host_actions(a, batch_.size(), &actions_);
-    if (!problem.empty()) return fail(e, "kage: " + problem);
+    if (!checked_host_actions(a, batch_.size(), &actions_, &last_error_kind_, e)) return false;
+    last_error_kind_ = ErrorKind::kNone;
     return batch_.step(actions_.data()), true;
   }
   Backend backend() const override { return Backend::kCpu; }
@@ -197,17 +211,19 @@ class GpuEnv final : public Env {
   // The members free device memory: in this batch's context, whichever thread drops the last reference.
   ~GpuEnv() override { cuCtxSetCurrent(ctx_); }
   bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* e) override {
-    return bind(e) && no_pending_error(e) && batch_.reset(seeds, mask, e);
+    last_error_kind_ = ErrorKind::kOther;
+    return bind(e) && no_pending_error(e) && batch_.reset(seeds, mask, e) && succeeded();
   }
   bool step(const Actions& a, std::string* e) override {
+    last_error_kind_ = ErrorKind::kOther;
     if (!bind(e) || !no_pending_error(e)) return false;
     if (a.memory == Memory::kDevice) {
       if (a.dtype != DType::kInt32 && a.dtype != DType::kInt64) return fail(e, "kage: actions must be int32 or int64");
-      return batch_.step(DeviceActions{reinterpret_cast<CUdeviceptr>(a.data), a.stride, a.dtype == DType::kInt64}, e);
+      return batch_.step(DeviceActions{reinterpret_cast<CUdeviceptr>(a.data), a.stride, a.dtype == DType::kInt64}, e) &&
+             succeeded();
     }
-    const std::string problem = host_actions(a, batch_.size(), &actions_);
-    if (!problem.empty()) return fail(e, "kage: " + problem);
-    return batch_.step(actions_.data(), e);
+    if (!checked_host_actions(a, batch_.size(), &actions_, &last_error_kind_, e)) return false;
+    return batch_.step(actions_.data(), e) && succeeded();
   }
   Backend backend() const override { return Backend::kGpu; }
   int32_t num_envs() const override { return batch_.size(); }
@@ -225,7 +241,10 @@ class GpuEnv final : public Env {
   const uint8_t* final_obs() const override { return reinterpret_cast<const uint8_t*>(batch_.final_obs()); }
   const void* final_info(InfoField f) const override { return info_column(batch_.final_info(), f); }
   bool copy_obs(uint8_t* dst, std::string* e) const override { return bind(e) && batch_.download_obs(dst, e); }
-  bool synchronize(std::string* e) override { return bind(e) && batch_.synchronize(e) && no_pending_error(e); }
+  bool synchronize(std::string* e) override {
+    last_error_kind_ = ErrorKind::kOther;
+    return bind(e) && batch_.synchronize(e) && no_pending_error(e) && succeeded();
+  }
   std::string pending_error() override {
     const std::optional<ActionError> e = batch_.take_action_error();
     if (!e) return {};
@@ -249,7 +268,13 @@ class GpuEnv final : public Env {
   }
   bool no_pending_error(std::string* e) {
     const std::string problem = pending_error();
-    return problem.empty() || fail(e, problem);
+    if (problem.empty()) return true;
+    last_error_kind_ = ErrorKind::kAction;
+    return fail(e, problem);
+  }
+  bool succeeded() {
+    last_error_kind_ = ErrorKind::kNone;
+    return true;
   }
 
   CUcontext ctx_;

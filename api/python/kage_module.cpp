@@ -24,11 +24,11 @@ namespace py = pybind11;
 namespace {
 
 /// Raised by open(): a Python exception class and the kind it stands for (set up in the module init).
-struct OpenErrors {
+struct ErrorClasses {
   py::object config, file, device, usage, other;
 };
-OpenErrors& open_errors() {
-  static OpenErrors e;
+ErrorClasses& error_classes() {
+  static ErrorClasses e;
   return e;
 }
 
@@ -331,10 +331,13 @@ class PyEnv {
     return s + ")";
   }
 
-  /// A failed reset or step: an out-of-range action is a ValueError, anything else a RuntimeError.
-  static void raise_step_error(const std::string& error) {
-    if (error.find(kage::action_range_text()) != std::string::npos) raise_value_error(error);
-    throw std::runtime_error(error);
+  /// A failed reset, step or synchronize, raised by the kind the runtime reports: an action outside 0..7 as
+  /// the package's usage error class (ValueError), anything else as its other class (RuntimeError).
+  void raise_step_error(const std::string& error) const {
+    const ErrorClasses& e = error_classes();
+    const py::object& cls = env().last_error_kind() == kage::ErrorKind::kAction ? e.usage : e.other;
+    PyErr_SetObject(cls.ptr(), py::str(error).ptr());
+    throw py::error_already_set();
   }
 
   void run_step(const kage::Actions& a) {
@@ -366,7 +369,7 @@ PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& dev
     env = kage::open(path, o, &error, &kind);
   }
   if (env) return PyEnv(std::shared_ptr<kage::Env>(std::move(env)));
-  const OpenErrors& e = open_errors();
+  const ErrorClasses& e = error_classes();
   const py::object& cls = kind == kage::ErrorKind::kConfig   ? e.config
                           : kind == kage::ErrorKind::kFile   ? e.file
                           : kind == kage::ErrorKind::kDevice ? e.device
@@ -379,7 +382,7 @@ PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& dev
 /// The JSON of a front-end call, or its diagnostics raised as the config error class.
 std::string front_end_json(const kage::python::FrontEndResult& r) {
   if (r.ok()) return r.json;
-  PyErr_SetObject(open_errors().config.ptr(), py::str(r.error).ptr());
+  PyErr_SetObject(error_classes().config.ptr(), py::str(r.error).ptr());
   throw py::error_already_set();
 }
 
@@ -389,23 +392,24 @@ PYBIND11_MODULE(_kage, m) {
   m.doc() = "Binding of the kage C++ API (include/kage/kage.h); use the kage package instead.";
 
   // open() raises these, by failure kind; the kage package names them (kage.ConfigError, ...).
-  OpenErrors& e = open_errors();
+  ErrorClasses& e = error_classes();
   e.config = py::reinterpret_borrow<py::object>(PyExc_ValueError);
   e.file = py::reinterpret_borrow<py::object>(PyExc_FileNotFoundError);
   e.device = py::reinterpret_borrow<py::object>(PyExc_RuntimeError);
   e.usage = py::reinterpret_borrow<py::object>(PyExc_ValueError);
   e.other = py::reinterpret_borrow<py::object>(PyExc_RuntimeError);
   m.def(
-      "set_open_errors",
+      "set_errors",
       [](py::object config, py::object file, py::object device, py::object usage, py::object other) {
-        OpenErrors& e = open_errors();
+        ErrorClasses& e = error_classes();
         e.config = std::move(config);
         e.file = std::move(file);
         e.device = std::move(device);
         e.usage = std::move(usage);
         e.other = std::move(other);
       },
-      "Exception classes open() raises for a config, file, device, usage and any other error.");
+      "Exception classes raised for a config, file, device, usage (an action outside 0..7 among them) and any "
+      "other error, chosen by the runtime's error kind.");
 
   m.def("gpu_backend_built", &kage::gpu_backend_built);
   m.def("action_range_text", &kage::action_range_text, "The text in every error about an action outside 0..7.");

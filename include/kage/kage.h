@@ -84,6 +84,17 @@ struct Actions {
   int64_t stride = 1;           ///< in elements
 };
 
+/// What a failure was about: open() reports it through `kind`, an Env's calls through last_error_kind().
+enum class ErrorKind {
+  kNone,
+  kConfig,  ///< the config has errors: the message holds the located diagnostics (file:line:col)
+  kFile,    ///< a compiled directory is missing a file or is not one
+  kDevice,  ///< no usable GPU (no driver, no device, or a build without the GPU backend)
+  kUsage,   ///< an option is out of range
+  kAction,  ///< an action outside 0..7 (action_range_text())
+  kOther,
+};
+
 /// A batch of environments of one configuration.
 class Env {
  public:
@@ -139,6 +150,9 @@ class Env {
   /// An out-of-range device action reported by a step that has finished since the last report (empty
   /// if none); does not wait.
   virtual std::string pending_error() = 0;
+  /// What the last failed reset, step or synchronize was about (kAction for an action outside 0..7, else
+  /// kOther); kNone after a call that succeeded.
+  ErrorKind last_error_kind() const { return last_error_kind_; }
 
   /// The whole batch's state and last outputs (about 1.4 KB per environment, not the observations),
   /// readable by load_state on either backend. Waits for queued work.
@@ -146,17 +160,11 @@ class Env {
   /// Restores a state saved from the same configuration and environment count, then renders its
   /// observations: the batch continues exactly as the one that was saved.
   [[nodiscard]] virtual bool load_state(const uint8_t* data, size_t size, std::string* error = nullptr) = 0;
+
+ protected:
+  ErrorKind last_error_kind_ = ErrorKind::kNone;
 };
 
-/// What an open() failure was about.
-enum class ErrorKind {
-  kNone,
-  kConfig,  ///< the config has errors: the message holds the located diagnostics (file:line:col)
-  kFile,    ///< a compiled directory is missing a file or is not one
-  kDevice,  ///< no usable GPU (no driver, no device, or a build without the GPU backend)
-  kUsage,   ///< an option is out of range
-  kOther,
-};
 
 /// Opens `path`: a directory with manifest.json (from `kagec compile`) or a YAML config. Null on error,
 /// with the message in `error` and its kind in `kind` (if given).

@@ -1,18 +1,45 @@
-"""kage: KAGE-Env batches for Python, on the CPU or the GPU, without copies between the runtime and
-the learner. See ``make_vec`` and ``VecEnv``; ``python3 -m kage.train`` trains the PPO-CNN baseline and
-``python3 -m kage.bench`` runs and reports the benchmark."""
-from kage._kage import DeviceArray, gpu_backend_built
-from kage.errors import ConfigError, Diagnostic, DeviceUnavailableError
-from kage.vector import INFO_FIELDS, VecEnv, env_seeds, make_vec
+"""kage: KAGE-Env batches for Python, on the CPU or the GPU, without copies between the runtime and the
+learner, and the front end's checks of configs and suites.
 
-__all__ = [
-    "ConfigError",
-    "DeviceArray",
-    "DeviceUnavailableError",
-    "Diagnostic",
-    "INFO_FIELDS",
-    "VecEnv",
-    "env_seeds",
-    "gpu_backend_built",
-    "make_vec",
-]
+The package has three layers, each importing only those below it:
+- ``kage`` (this package): the environment API (``make_vec``, ``VecEnv``, spaces, errors, ``kage.front_end``);
+- ``kage.ppo``: the PPO-CNN baseline (``python3 -m kage.ppo.train``, ``python3 -m kage.ppo.evaluate``);
+- ``kage.bench``: the benchmark runner (``python3 -m kage.bench run|report|score|status|slurm|speed``).
+
+Importing ``kage`` loads neither torch nor the compiled extension: names below load what they need on
+first use.
+"""
+import importlib
+
+# name -> the module that defines it (loaded on first access, PEP 562).
+_LAZY = {
+    "ConfigError": "kage.errors",
+    "Diagnostic": "kage.errors",
+    "DeviceUnavailableError": "kage.errors",
+    "INFO_FIELDS": "kage.vector",
+    "VecEnv": "kage.vector",
+    "env_seeds": "kage.vector",
+    "make_vec": "kage.vector",
+    "DeviceArray": "kage._native",
+    "gpu_backend_built": "kage._native",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'kage' has no attribute '{name}'")
+    if module == "kage._native":
+        from kage._native import native
+
+        value = getattr(native(), name)
+    else:
+        value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_LAZY))

@@ -10,13 +10,11 @@ from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from kage import _kage, actions as _actions, spaces
-from kage.errors import ConfigError, DeviceUnavailableError
-
-_kage.set_open_errors(ConfigError, FileNotFoundError, DeviceUnavailableError, ValueError, RuntimeError)
+from kage import actions as _actions, front_end, spaces
+from kage._native import native
 
 #: (name, numpy dtype, meaning) of every info field, in the runtime's order.
-INFO_FIELDS = tuple(_kage.info_fields())
+INFO_FIELDS = tuple(native().info_fields())
 
 Seed = Union[int, Sequence[int], None]
 
@@ -53,9 +51,11 @@ class VecEnv:
 
     metadata = {"autoreset_mode": "same-step"}
 
-    def __init__(self, handle: "_kage.Env", config: str, seed: int):
+    def __init__(self, handle: "kage._kage.Env", config: str, seed: int, asset_root: Optional[str] = None):
         self._handle = handle
         self.config = config
+        self._asset_root = asset_root
+        self._spec: Optional[dict] = None
         self.num_envs = handle.num_envs
         self.device = handle.device
         self.spec_hash = handle.spec_hash
@@ -163,6 +163,22 @@ class VecEnv:
         return self._live().stream
 
     @property
+    def resolved_spec(self) -> dict:
+        """The resolved Spec the batch runs, as ``kagec resolve`` prints it (``{"config": {...}, "sha256": ...}``;
+        Gymnasium's ``spec`` is another thing, an EnvSpec). Resolved on first use and checked against the
+        batch's ``spec_hash``: a config file edited since ``make_vec`` raises instead of describing another game."""
+        if self._spec is None:
+            if os.path.isdir(self.config):
+                raise ValueError(f"{self.config} is a kagec compile directory, which holds no Spec: resolve the YAML "
+                                 "config it was compiled from (kage.front_end.resolve)")
+            spec = front_end.resolve(self.config, self._asset_root)
+            if spec["sha256"] != self.spec_hash:
+                raise RuntimeError(f"{self.config} changed since this environment was made (spec "
+                                   f"{self.spec_hash[:12]} then, {spec['sha256'][:12]} now): make the environment again")
+            self._spec = spec
+        return self._spec
+
+    @property
     def closed(self) -> bool:
         return self._handle is None
 
@@ -170,7 +186,7 @@ class VecEnv:
         state = "closed" if self.closed else f"{self.num_envs} envs on {self.device}"
         return f"<kage.VecEnv {self.config!r}, {state}, spec {self.spec_hash[:12]}>"
 
-    def _live(self) -> "_kage.Env":
+    def _live(self) -> "kage._kage.Env":
         if self._handle is None:
             raise RuntimeError("this environment is closed: make a new one with kage.make_vec")
         return self._handle
@@ -210,5 +226,5 @@ def make_vec(config: Union[str, os.PathLike], num_envs: int, device: str = "cpu"
     if device == "cpu" and stream is not None:
         raise ValueError("stream= is for device='cuda'")
     stream_handle = 0 if stream is None else int(getattr(stream, "cuda_stream", stream))
-    handle = _kage.open(config, int(num_envs), device, int(threads), asset_root or "", stream_handle)
-    return VecEnv(handle, config, int(seed))
+    handle = native().open(config, int(num_envs), device, int(threads), asset_root or "", stream_handle)
+    return VecEnv(handle, config, int(seed), asset_root)

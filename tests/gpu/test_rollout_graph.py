@@ -3,21 +3,17 @@ after the parameters have changed by optimizer steps, with and without --bf16.""
 import pytest
 import torch
 
-from kage.agent import Agent, autocast
-from kage.agent import RolloutPolicy
-from kage.train import Args
+from kage.ppo.agent import Agent
+from kage.ppo.policy import RolloutPolicy, autocast
 
 
 @pytest.mark.parametrize("bf16", [False, True])
 def test_graph_replay_follows_the_updated_parameters(bf16):
     device = torch.device("cuda")
-    agent = Agent([1, 2], 3, 128, 128, device)
-    if bf16:
-        agent.input_dtype = torch.bfloat16
-    args = Args(cuda_graph=True, bf16=bf16)
+    agent = Agent([1, 2], 3, 128, 128, device, bf16=bf16)
     obs_shape = (2, 16, 128, 128, 3)
-    graph = RolloutPolicy(agent, args, obs_shape, device)
-    eager = RolloutPolicy(agent, Args(cuda_graph=False, bf16=bf16), obs_shape, device)
+    graph = RolloutPolicy(agent, obs_shape, 8, device, bf16=bf16, cuda_graph=True)
+    eager = RolloutPolicy(agent, obs_shape, 8, device, bf16=bf16, cuda_graph=False)
     optimizer = torch.optim.Adam(agent.parameters(), lr=1e-3)
     generator = torch.Generator(device).manual_seed(0)
     for _ in range(5):

@@ -1,5 +1,5 @@
 """Your own agent through `python3 -m kage.bench run` (CPU, tiny flags, a one-pair suite of 40-step
-episodes): the example agent (the baseline with kage.augment:random_shift) trains packed and reports; a
+episodes): the example agent (the baseline with kage.ppo.augment:random_shift) trains packed and reports; a
 plug-in network that cannot be packed trains its runs one at a time under --pack, saying so."""
 import json
 import os
@@ -30,14 +30,14 @@ def one_pair_suite(folder):
 def test_example_agent_trains_packed_and_reports(tmp_path):
     out = tmp_path / "shift"
     done = bench("run", one_pair_suite(tmp_path), "--seeds", "1-2", "--pack", "2", "--out", str(out), *TINY,
-                 "--augment", "kage.augment:random_shift")
+                 "--augment", "kage.ppo.augment:random_shift")
     assert done.returncode == 0, done.stderr
     assert len(json.loads((out / "packs" / "pack_0.json").read_text())["runs"]) == 2
     for seed in (1, 2):
         run_dir = out / "runs" / "look/1" / f"seed_{seed}"
         assert (run_dir / "summary.json").exists(), (out / "packs" / "pack_0.log").read_text()
         args = json.loads((run_dir / "run.json").read_text())["args"]
-        assert args["augment"] == "kage.augment:random_shift" and args["agent"] == "kage.agent:nature_cnn"
+        assert args["augment"] == "kage.ppo.augment:random_shift" and args["agent"] == "kage.ppo.agent:nature_cnn"
         evals = [json.loads(line) for line in open(run_dir / "metrics.jsonl") if '"kind": "eval"' in line]
         assert [e["iteration"] for e in evals] == [0, 2] and evals[-1]["evals"]["eval"]["episodes"] >= 2
     reported = bench("report", str(out))

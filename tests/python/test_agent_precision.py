@@ -3,7 +3,7 @@
 in noise (a run under --bf16 stopped learning that way). CPU autocast stands in for the GPU's here."""
 import torch
 
-from kage.agent import Agent
+from kage.ppo.agent import Agent
 
 
 def test_heads_stay_float32_under_bf16_autocast():

@@ -1,7 +1,7 @@
 """One tiny training run (CPU, 40-step episodes) with a counting augmentation, videos and a recording
-TensorBoard writer, then `python3 -m kage.evaluate` on its checkpoint: the augmentation is applied to the
+TensorBoard writer, then `python3 -m kage.ppo.evaluate` on its checkpoint: the augmentation is applied to the
 update's minibatches only, never in an evaluation or a video; the scalars carry the original's tags;
-kage.evaluate reproduces the run's last evaluation, writes the report's tables, refuses a config of
+kage.ppo.evaluate reproduces the run's last evaluation, writes the report's tables, refuses a config of
 another observation size, and records GIFs of the episode's length in frames (or one per stride)."""
 import csv
 import json
@@ -14,7 +14,7 @@ import torch
 from PIL import Image
 
 import counting_augment
-from kage import tensorboard_log, train, video
+from kage.ppo import tensorboard_log, train, video
 from support import NOISY_SKELETON, ROOT
 
 EPISODE_LENGTH = 40  # noisy_short.yaml's episode_length
@@ -73,9 +73,13 @@ def evaluations(out):
     return [json.loads(line) for line in open(out / "metrics.jsonl") if '"kind": "eval"' in line]
 
 
-def evaluate(*args):
-    return subprocess.run([sys.executable, "-m", "kage.evaluate", *args, "--episodes", "2", "--num-envs", "2",
+def evaluate(*args, module="kage.ppo.evaluate"):
+    return subprocess.run([sys.executable, "-m", module, *args, "--episodes", "2", "--num-envs", "2",
                            "--device", "cpu", "--threads", "1"], cwd=ROOT, capture_output=True, text=True, timeout=600)
+
+
+def score(*args):
+    return evaluate("score", *args, module="kage.bench")
 
 
 def test_augmentation_only_on_update_minibatches(run):
@@ -132,7 +136,7 @@ def test_checkpoint_without_agent_spec_is_rebuilt_from_its_run_directory(run, tm
         (older / name).parent.mkdir(parents=True, exist_ok=True)
         (older / name).write_bytes((out / name).read_bytes())
     state = torch.load(out / "checkpoints" / "latest.pt", weights_only=False)
-    del state["agent_spec"]  # as kage.train wrote checkpoints before --agent
+    del state["agent_spec"]  # as kage.ppo.train wrote checkpoints before --agent
     (older / "checkpoints").mkdir()
     torch.save(state, older / "checkpoints" / "latest.pt")
     done = evaluate(str(older), "--config", NOISY_SKELETON, "--out", str(tmp_path / "eval"))
@@ -148,8 +152,8 @@ def test_evaluate_suite_writes_the_report_tables(run, tmp_path):
     (tmp_path / "suite.yaml").write_text(
         "suite: tiny\ndescription: one pair\npairs:\n  - name: look/1\n    axis: background\n"
         f"    description: noise to black\n    train: {NOISY_SKELETON}\n    eval: black.yaml\n")
-    done = evaluate(str(out / "checkpoints" / "latest.pt"), "--suite", str(tmp_path / "suite.yaml"),
-                    "--out", str(tmp_path / "eval"))
+    done = score(str(out / "checkpoints" / "latest.pt"), "--suite", str(tmp_path / "suite.yaml"),
+                 "--out", str(tmp_path / "eval"))
     assert done.returncode == 0, done.stderr
     for name in ("axes.md", "axes.csv", "pairs.md", "pairs.csv", "runs.csv", "report.md", "evaluation.json"):
         assert (tmp_path / "eval" / name).stat().st_size > 100, name

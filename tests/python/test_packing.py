@@ -16,7 +16,7 @@ import json
 import pytest
 import torch
 
-from kage import train
+from kage.ppo import train
 from support import CONFIGS
 
 FLAGS = dict(device="cpu", threads=1, total_timesteps=192, num_envs=2, num_steps=16, num_minibatches=2, update_epochs=2,

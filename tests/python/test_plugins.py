@@ -6,20 +6,20 @@ import math
 import pytest
 import torch
 
-from kage import plugins, tensorboard_log
-from kage.augment import PAD, random_shift
-from kage.evaluation import METRICS
+from kage.ppo import plugins, tensorboard_log
+from kage.ppo.augment import PAD, random_shift
+from kage.ppo.evaluation import METRICS
 
 SHAPE = (16, 16, 3)
 
 
 def test_references_are_checked_with_their_fix():
     with pytest.raises(SystemExit, match="write it as module:attribute"):
-        plugins.load("kage.agent.nature_cnn", "--agent")
+        plugins.load("kage.ppo.agent.nature_cnn", "--agent")
     with pytest.raises(SystemExit, match="cannot import 'no_such_module'.*PYTHONPATH"):
         plugins.load("no_such_module:make", "--agent")
     with pytest.raises(SystemExit, match="has no 'nature_cnnn'; did you mean 'nature_cnn'"):
-        plugins.load("kage.agent:nature_cnnn", "--agent")
+        plugins.load("kage.ppo.agent:nature_cnnn", "--agent")
     with pytest.raises(SystemExit, match="has no 'xyz'; it defines TinyNet, make, wrong_shape"):
         plugins.load("lone_agent:xyz", "--agent")
     with pytest.raises(SystemExit, match=r"must take \(obs, uniform\)"):
@@ -27,7 +27,7 @@ def test_references_are_checked_with_their_fix():
 
 
 def test_agents_are_built_in_the_pack_interface():
-    packed = plugins.build_agent("kage.agent:nature_cnn", (44, 44, 3), 5, [1, 2], "cpu")
+    packed = plugins.build_agent("kage.ppo.agent:nature_cnn", (44, 44, 3), 5, [1, 2], "cpu")
     logits, value = packed(torch.zeros((2, 7, 44, 44, 3), dtype=torch.uint8))
     assert logits.shape == (2, 7, 5) and value.shape == (2, 7)
 

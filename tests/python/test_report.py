@@ -318,7 +318,7 @@ def test_a_damaged_log_line_before_the_last_is_an_error(tmp_path):
 def test_a_summary_of_another_shape_is_an_error(tmp_path):
     run = one_pair_bench(tmp_path)
     (run / "summary.json").write_text(json.dumps({"kage_summary": 1, "stats": {"train/success": {"min": 0.0}}}))
-    with pytest.raises(SystemExit, match=r"summary.json is not a kage.train summary.*delete it and rerun"):
+    with pytest.raises(SystemExit, match=r"summary.json is not a kage.ppo.train summary.*delete it and rerun"):
         report.report(str(tmp_path))
     (run / "summary.json").write_text(json.dumps({"kage_summary": 1, "stats": {}}))
     with pytest.raises(SystemExit, match=r"summary.json has no 'train/passed_distance'"):

@@ -3,7 +3,7 @@
 import json
 import math
 
-from kage.rundir import RunDir
+from kage.ppo.rundir import RunDir
 
 
 def test_non_finite_values_are_logged_as_null(tmp_path, capsys):
@@ -16,5 +16,5 @@ def test_non_finite_values_are_logged_as_null(tmp_path, capsys):
                        "losses/entropy": 0.5}
     assert rows[1] == {"kind": "train", "iteration": 8, "losses/loss": None, "losses/entropy": 0.25}
     warnings = capsys.readouterr().err.splitlines()
-    assert warnings == [f"kage.train: warning: {tmp_path}: losses/loss, losses/value_loss not finite at "
+    assert warnings == [f"kage.ppo.train: warning: {tmp_path}: losses/loss, losses/value_loss not finite at "
                         "iteration 7: the run has diverged; such values are logged as null"]

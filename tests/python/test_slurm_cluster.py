@@ -102,7 +102,7 @@ def test_job_array_on_a_local_slurm(tmp_path):
                                 "the resubmitted task to end", timeout=900)
         assert states == {"0": "COMPLETED"}, f"{states}\n{task_logs(out)}"
         log = (run_dir / "train.log").read_text()
-        assert f"kage.train: resuming {run_dir} after iteration {stopped_at}" in log, log
+        assert f"kage.ppo.train: resuming {run_dir} after iteration {stopped_at}" in log, log
         rows = [json.loads(line) for line in open(run_dir / "metrics.jsonl")]
         assert [r["iteration"] for r in rows if r["kind"] == "train"] == list(range(1, 41))  # no iteration twice
         assert (run_dir / "summary.json").exists()

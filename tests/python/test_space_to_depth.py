@@ -1,4 +1,4 @@
-"""kage.space_to_depth: a stride-s convolution equals the stride-1 convolution of the input's s x s blocks
+"""kage.ppo.fast.space_to_depth: a stride-s convolution equals the stride-1 convolution of the input's s x s blocks
 with the rearranged weight, for conv1's shape (8x8, stride 4, 3 channels) and conv2's (4x4, stride 2,
 32 channels, an odd side whose last row and column no window reads). --fused-input and the GPU-only
 --triton-conv rely on these formulas; here they are checked on the CPU against torch's own strided
@@ -7,7 +7,7 @@ import pytest
 import torch
 import torch.nn.functional as F
 
-from kage.space_to_depth import space_to_depth, weight_space_to_depth
+from kage.ppo.fast.space_to_depth import space_to_depth, weight_space_to_depth
 
 
 @pytest.mark.parametrize("side, channels, kernel, stride", [(44, 3, 8, 4), (31, 32, 4, 2)])

@@ -48,7 +48,7 @@ def test_sigterm_checkpoints_and_resumes(tmp_path):
     assert child.returncode == 128 + signal.SIGTERM, output
     assert "kage.bench run: stopped background/1 seed 1; run again (or requeue) to resume" in output
     log = (run_dir / "train.log").read_text()
-    assert "kage.train: stopped after iteration" in log
+    assert "kage.ppo.train: stopped after iteration" in log
     checkpointed = json.loads((run_dir / "checkpoints" / "latest.json").read_text())["iteration"]
     assert checkpointed == train_rows(run_dir) >= 2  # no finished iteration lost
     assert checkpointed < 8 and not (run_dir / "summary.json").exists()

@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from kage import train
+from kage.ppo import args as trainer_args, train
 from support import CONFIGS, NEAR_GOAL
 
 OPTIONS = ["--use-frame-stack", "--normalize-reward", "--bootstrap-truncation", "--anneal-lr", "--ent-coef-anneal",
@@ -35,8 +35,8 @@ def test_every_option_at_once(tmp_path):
 
 def test_triton_conv_without_triton(monkeypatch, capsys):
     """Where triton is not installed (as on the CPU machines), --triton-conv is refused before training."""
-    real_find_spec = train.importlib.util.find_spec
-    monkeypatch.setattr(train.importlib.util, "find_spec",
+    real_find_spec = trainer_args.importlib.util.find_spec
+    monkeypatch.setattr(trainer_args.importlib.util, "find_spec",
                         lambda name, *rest: None if name == "triton" else real_find_spec(name, *rest))
     with pytest.raises(SystemExit):
         train.parse_args(["--train-config-path", NEAR_GOAL, "--device", "cuda", "--fused-input", "--triton-conv"])

@@ -20,7 +20,7 @@ FLAGS = ["--train-config-path", str(CONFIGS / "near_goal.yaml"),
 
 
 def train(out, **popen):
-    return subprocess.Popen([sys.executable, "-m", "kage.train", *FLAGS, "--out", str(out)],
+    return subprocess.Popen([sys.executable, "-m", "kage.ppo.train", *FLAGS, "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, **popen)
 
 

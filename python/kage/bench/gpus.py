@@ -14,7 +14,7 @@ import time
 from typing import List
 
 from kage.bench import tasks
-from kage.stop import stop_children
+from kage.util.stop import stop_children
 
 FAKE_GPUS = "KAGE_BENCH_FAKE_GPUS"
 

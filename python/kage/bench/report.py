@@ -5,7 +5,7 @@ Input, as `python3 -m kage.bench run` writes it:
     DIR/suite.json                 the suite's pairs (kagec suite): names, axes, sweeps, certificates
     DIR/bench.json                 the seeds and units asked for, and under --share-training each
                                    pair's shared run and label (optional here)
-    DIR/runs/<unit>/seed_<s>/      a kage.train run directory: a plain pair's (unit = the pair's name, eval
+    DIR/runs/<unit>/seed_<s>/      a kage.ppo.train run directory: a plain pair's (unit = the pair's name, eval
                                    label "eval"), a sweep's (unit = the sweep's name, one eval label per
                                    eval config: its name in the sweep), or a shared run's (several plain
                                    pairs with one train config, one eval label per pair)
@@ -50,15 +50,15 @@ import os
 import re
 import statistics
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Dict, List, NoReturn, Optional, Sequence, Tuple
 
 from kage.bench import plots
+from kage.bench.units import Unit, units_of
 from kage.bench.tables import METRICS, SUCCESS_SHOWN, write_tables
-from kage.files import atomic_write, safe
+from kage.util.files import atomic_write, safe
 
-DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # as kage.train logs
-PLAIN_LABEL = "eval"  # the eval label of a plain pair's runs (kage.bench run)
+DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # as kage.ppo.train logs
 
 
 def fail(message: str) -> NoReturn:
@@ -66,19 +66,6 @@ def fail(message: str) -> NoReturn:
 
 
 # ---- reading the benchmark directory ----
-
-@dataclass
-class Unit:
-    """What one run per seed trains: a plain pair, or a whole sweep (its eval configs in manifest order)."""
-
-    name: str
-    is_sweep: bool
-    pairs: List[dict]  # the suite.json entries
-    labels: Dict[str, str] = field(default_factory=dict)  # pair -> eval label, where not label_of's
-
-    def label(self, pair: dict) -> str:
-        return self.labels.get(pair["pair"], label_of(pair))
-
 
 @dataclass
 class Run:
@@ -125,30 +112,6 @@ def read_bench(bench_dir: str) -> dict:
     return bench if isinstance(bench, dict) else {}
 
 
-def units_of(suite: dict, selected: Optional[List[str]] = None,
-             shared: Optional[Dict[str, List[str]]] = None) -> List[Unit]:
-    """The suite's plain pairs and sweeps in manifest order, as kage.bench run trains them; only the
-    `selected` ones (bench.json's "units": what `run --pairs` chose) when given. `shared` (bench.json's, under
-    --share-training) puts a pair in the shared run that trained it: {pair: [unit, label]}."""
-    shared = shared or {}
-    units: Dict[str, Unit] = {}
-    for pair in suite["pairs"]:
-        if pair["pair"] in shared:
-            name, label = shared[pair["pair"]]
-            unit = units.setdefault(name, Unit(name, False, []))
-            unit.pairs.append(pair)
-            unit.labels[pair["pair"]] = label
-        elif pair["sweep"] is None:
-            units[pair["pair"]] = Unit(pair["pair"], False, [pair])
-        else:
-            units.setdefault(pair["sweep"], Unit(pair["sweep"], True, [])).pairs.append(pair)
-    return [u for u in units.values() if selected is None or u.name in selected]
-
-
-def label_of(pair: dict) -> str:
-    return PLAIN_LABEL if pair["sweep"] is None else pair["sweep_eval"]
-
-
 def find_runs(bench_dir: str, unit: Unit) -> List[Run]:
     """The unit's run directories (runs/<unit>/seed_<s>/), by seed."""
     unit_dir = os.path.join(bench_dir, "runs", unit.name)
@@ -183,7 +146,7 @@ def read_summary(path: str) -> dict:
     stats = summary.get("stats") if isinstance(summary, dict) else None
     if not (isinstance(summary, dict) and summary.get("kage_summary") == 1 and isinstance(stats, dict)
             and all(v is None or (isinstance(v, dict) and is_number(v.get("max"))) for v in stats.values())):
-        fail(f"{path} is not a kage.train summary ({{\"kage_summary\": 1, \"stats\": {{key: {{\"max\": number, ...}} "
+        fail(f"{path} is not a kage.ppo.train summary ({{\"kage_summary\": 1, \"stats\": {{key: {{\"max\": number, ...}} "
              f"or null}}}}): {remedy}")
     return stats
 
@@ -208,7 +171,7 @@ def read_evaluations(path: str) -> List[dict]:
             fail(f"{path}, line {number}: not a JSON row, the log is damaged: delete that line, or delete the run "
                  "directory and rerun `python3 -m kage.bench run` to train the run again")
         if not isinstance(row, dict) or "kind" not in row:
-            fail(f"{path}, line {number}: not a kage.train log row (no \"kind\"): delete that line, or delete the run "
+            fail(f"{path}, line {number}: not a kage.ppo.train log row (no \"kind\"): delete that line, or delete the run "
                  "directory and rerun `python3 -m kage.bench run` to train the run again")
         if row["kind"] == "eval":
             if not (is_number(row.get("global_step")) and isinstance(row.get("train"), dict)
@@ -399,7 +362,8 @@ def report(bench_dir: str, out_dir: Optional[str] = None) -> dict:
     suite = load_suite(bench_dir)
     bench = read_bench(bench_dir)
     out_dir = out_dir or os.path.join(bench_dir, "report")
-    units = units_of(suite, bench.get("units"), bench.get("shared"))
+    selected = bench.get("units")  # what `run --pairs` chose, when it chose
+    units = [u for u in units_of(suite, bench.get("shared")) if selected is None or u.name in selected]
     runs = {unit.name: find_runs(bench_dir, unit) for unit in units}
     levels = aggregate(units, runs)
     status = run_status(units, runs, [s for s in bench.get("seeds", []) if isinstance(s, int)])

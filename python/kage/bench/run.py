@@ -1,7 +1,7 @@
 """python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [--pack K] [--share-training]
 [--task I | --gpus all|0,2] [trainer flags]
 
-Trains every (pair, seed) of a suite manifest with `python3 -m kage.train`, each run in its own run
+Trains every (pair, seed) of a suite manifest with `python3 -m kage.ppo.train`, each run in its own run
 directory, one process after the other; --pack K trains K runs at once in one process (one GPU), which
 the learner's batched forward and backward make several times faster in aggregate. The runs form a fixed
 task table (kage.bench.tasks): --task I trains task I alone (a Slurm array task, kage.bench slurm), and
@@ -12,7 +12,7 @@ seed, in one run that evaluates all their eval configs (the 34 pairs of KAGE-Ben
     DIR/suite.json                  the suite's report (kagec suite): pairs, axes, paths, spec hashes, certificates
     DIR/bench.json                  the manifest, the seeds asked for so far, the trainer flags and the shared runs
     DIR/tasks.json                  the task table: the runs of each task
-    DIR/runs/<pair>/seed_<s>/       a training run (kage.train's run directory), its train.log and
+    DIR/runs/<pair>/seed_<s>/       a training run (kage.ppo.train's run directory), its train.log and
                                     bench_state.json (running, failed or stopped: kage.bench.run_state)
     DIR/packs/pack_<i>.json, .log   under --pack: the runs one process trained together, and its log
                                     (task_<I>_pack_<i> under --task I)
@@ -26,7 +26,6 @@ changed since DIR was started.
 """
 import argparse
 import dataclasses
-import difflib
 import json
 import os
 import re
@@ -36,23 +35,13 @@ import sys
 import time
 from typing import Dict, List, Optional
 
-from kage import _kage, plugins
+from kage import front_end
+from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
+from kage.bench.units import Unit, select, units_of
 from kage.errors import ConfigError
-from kage.files import atomic_write, write_json
-from kage.stop import stop_children
-
-
-@dataclasses.dataclass
-class Unit:
-    """One trained thing per seed: a plain pair, or a whole sweep."""
-
-    name: str
-    axis: str
-    train: str
-    evals: List[str]
-    labels: List[str]
-    pairs: List[str] = dataclasses.field(default_factory=list)  # --share-training: the pairs, one per label
+from kage.util.files import atomic_write, write_json
+from kage.util.stop import stop_children
 
 
 def parse_seeds(text: str) -> List[int]:
@@ -69,36 +58,16 @@ def parse_seeds(text: str) -> List[int]:
     return sorted(set(seeds))
 
 
-def units_of(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
-    """The suite's pairs and sweeps, in manifest order, or the `wanted` ones."""
-    units: Dict[str, Unit] = {}
+def units_to_train(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
+    """The suite's pairs and sweeps, in manifest order, or the `wanted` ones; refuses configs written inline."""
     for p in report["pairs"]:
         if p["train"]["name"] == "(inline)" or p["eval"]["name"] == "(inline)":
             raise SystemExit(f"kage.bench: pair {p['pair']} writes a config inline in the manifest; "
                              "kage.bench trains only configs in files: move it to a file")
-        if p["sweep"] is None:
-            units[p["pair"]] = Unit(p["pair"], p["declared_axis"], p["train"]["name"], [p["eval"]["name"]], ["eval"])
-        else:
-            unit = units.setdefault(p["sweep"], Unit(p["sweep"], p["declared_axis"], p["train"]["name"], [], []))
-            unit.evals.append(p["eval"]["name"])
-            unit.labels.append(p["sweep_eval"])
-    if not wanted:
-        return list(units.values())
-    chosen = []
-    for name in wanted:
-        if name in units:
-            chosen.append(units[name])
-            continue
-        sweep = next((u.name for u in units.values() if name.startswith(u.name + "/") and len(u.evals) > 1), None)
-        if sweep:
-            raise SystemExit(f"kage.bench: {name} is one eval of the sweep '{sweep}'; select the sweep as a whole")
-        close = difflib.get_close_matches(name, units, n=3)
-        hint = f"; did you mean {', '.join(close)}?" if close else f"; the suite has {', '.join(list(units)[:6])} ..."
-        raise SystemExit(f"kage.bench: no pair or sweep named '{name}' in the suite{hint}")
-    return chosen
+    return select(units_of(report), wanted, "kage.bench")
 
 
-MAX_EVALS = 10  # eval configs per run (kage.train's limit, §3.5)
+MAX_EVALS = 10  # eval configs per run (kage.ppo.train's limit, §3.5)
 
 
 def share_training(units: List[Unit], report: dict) -> List[Unit]:
@@ -119,9 +88,9 @@ def share_training(units: List[Unit], report: dict) -> List[Unit]:
         chunks = [members[i:i + MAX_EVALS] for i in range(0, len(members), MAX_EVALS)]
         for number, chunk in enumerate(chunks, 1):
             part = f"-part{number}" if len(chunks) > 1 else ""
-            shared[chunk[0].name] = [Unit(f"shared/{stem}-{spec_hash[:8]}{part}", "(shared)", chunk[0].train,
-                                          [u.evals[0] for u in chunk], [u.name.replace("/", "_") for u in chunk],
-                                          [u.name for u in chunk])]
+            shared[chunk[0].name] = [Unit(f"shared/{stem}-{spec_hash[:8]}{part}", "(shared)",
+                                          [u.pairs[0] for u in chunk], shared=True,
+                                          labels={u.name: u.name.replace("/", "_") for u in chunk})]
             for u in chunk[1:]:
                 shared[u.name] = []
     return [v for u in units for v in shared.get(u.name, [u])]
@@ -153,7 +122,7 @@ def record_bench(out: str, manifest: str, seeds: List[int], units: List[Unit], t
     --share-training where each pair's results are ({pair: [unit, label]})."""
     path = os.path.join(out, "bench.json")
     names = [u.name for u in units]
-    shared = {pair: [u.name, label] for u in units for pair, label in zip(u.pairs, u.labels)}
+    shared = {p["pair"]: [u.name, u.label(p)] for u in units if u.shared for p in u.pairs}
     if os.path.exists(path):
         with open(path) as f:
             previous = json.load(f)
@@ -172,7 +141,7 @@ def record_bench(out: str, manifest: str, seeds: List[int], units: List[Unit], t
 
 def train_flags(unit: Unit, seed: int, run_dir: str, trainer_args: List[str]) -> List[str]:
     evals = ["--eval-config-path", unit.evals[0]] if len(unit.evals) == 1 else ["--eval-config-paths", *unit.evals]
-    return ["--train-config-path", unit.train, *evals, "--eval-config-labels", *unit.labels, "--seed", str(seed),
+    return ["--train-config-path", unit.train, *evals, "--eval-config-labels", *unit.eval_labels, "--seed", str(seed),
             "--out", run_dir, "--exp-name", unit.name.replace("/", "_"), *trainer_args]
 
 
@@ -195,8 +164,8 @@ def packs_of(jobs: List[tuple], size: int) -> List[List[tuple]]:
 
 
 def write_pack_file(path: str, pack: List[tuple], trainer_args: List[str]) -> str:
-    """The pack's runs as kage.train arguments (python3 -m kage.train --pack)."""
-    from kage import train
+    """The pack's runs as kage.ppo.train arguments (python3 -m kage.ppo.train --pack)."""
+    from kage.ppo import train
     runs = [dataclasses.asdict(train.parse_args(train_flags(u, s, d, trainer_args))) for u, s, d in pack]
     os.makedirs(os.path.dirname(path), exist_ok=True)
     atomic_write(path, json.dumps({"runs": runs}, indent=1).encode())  # infinities as Infinity: read by Python
@@ -304,7 +273,7 @@ def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
                  "--seed", "--out", "--exp-name"):
         if flag in trainer_args:
             raise SystemExit(f"kage.bench: {flag} is set per run by kage.bench; remove it")
-    from kage import train
+    from kage.ppo import train
     probe = train.parse_args(["--train-config-path", args.suite, *trainer_args])  # trainer flags checked now
     if args.pack > 1 and not plugins.is_packable(plugins.load(probe.agent, "--agent")):
         print(f"kage.bench run: --agent {probe.agent} cannot be packed (its factory does not set packable = True): "
@@ -313,14 +282,14 @@ def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
     seeds = parse_seeds(args.seeds)
     suite, out = os.path.abspath(args.suite), os.path.abspath(args.out)
     try:
-        report = json.loads(_kage.suite_report(suite))
+        report = front_end.suite_report(suite)
     except ConfigError as e:
         raise SystemExit(f"{e}\nkage.bench: fix the suite first") from None
-    units = units_of(report, args.pairs)
+    units = units_to_train(report, args.pairs)
     if args.share_training:
         units = share_training(units, report)
     for p in report["pairs"]:
-        if not p["certified"] and any(p["pair"] == u.name or p["sweep"] == u.name for u in units):
+        if not p["certified"] and any(p["pair"] == q["pair"] for u in units for q in u.pairs):
             print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
 
     os.makedirs(out, exist_ok=True)
@@ -358,7 +327,7 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
         run_state.mark(run_dirs, "running", task=task, log=log_path)
         with open(log_path, "ab") as log:
             # Its own session: a terminal's Ctrl-C or a kill of our process group reaches it through stop_children.
-            child = subprocess.Popen([sys.executable, "-m", "kage.train", *command], stdout=log, stderr=log,
+            child = subprocess.Popen([sys.executable, "-m", "kage.ppo.train", *command], stdout=log, stderr=log,
                                      start_new_session=True)
             try:
                 beat = time.monotonic()
@@ -394,7 +363,7 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
 
 def main(argv: List[str]) -> int:
     parser = argparse.ArgumentParser(prog="python3 -m kage.bench run", description=__doc__.split("\n\n")[0],
-                                     epilog="Any other flag is a trainer flag (python3 -m kage.train --help).")
+                                     epilog="Any other flag is a trainer flag (python3 -m kage.ppo.train --help).")
     add_bench_arguments(parser)
     parser.add_argument("--task", type=int, help="train only task I of DIR/tasks.json (a Slurm array task)")
     parser.add_argument("--gpus", help="'all' or a list like 0,2: one worker process per GPU, each training "

@@ -9,7 +9,7 @@ import socket
 import time
 from typing import List, Optional
 
-from kage.files import write_json
+from kage.util.files import write_json
 
 STATE_FILE = "bench_state.json"
 HEARTBEAT_S = 30.0
@@ -28,7 +28,7 @@ def mark(run_dirs: List[str], state: str, **details) -> None:
 
 
 def last_error(log_path: str) -> str:
-    """The last non-empty line of a log: a traceback's exception, or kage.train's message."""
+    """The last non-empty line of a log: a traceback's exception, or kage.ppo.train's message."""
     try:
         with open(log_path, "rb") as f:
             f.seek(max(0, os.path.getsize(log_path) - 16384))

@@ -20,7 +20,7 @@ import sys
 from typing import List
 
 from kage.bench import run, tasks
-from kage.files import atomic_write
+from kage.util.files import atomic_write
 
 PATH_FLAGS = ("--asset-root",)  # trainer flags that name a path: made absolute for the tasks
 
@@ -88,7 +88,7 @@ def submit(path: str) -> str:
 
 def main(argv: List[str]) -> int:
     parser = argparse.ArgumentParser(prog="python3 -m kage.bench slurm", description=__doc__.split("\n\n")[1],
-                                     epilog="Any other flag is a trainer flag (python3 -m kage.train --help).")
+                                     epilog="Any other flag is a trainer flag (python3 -m kage.ppo.train --help).")
     run.add_bench_arguments(parser)
     parser.add_argument("--partition", help="the Slurm partition (default: the cluster's default)")
     parser.add_argument("--time", help="time limit per array task, e.g. 4:00:00 (default: the partition's)")

@@ -1,6 +1,6 @@
 """python3 -m kage.bench speed [--packs 1,4,8,16,32] [--iterations 3] [trainer flags]
 
-Training speed of kage.train with K runs packed in one process, at the spec's per-run hyperparameters
+Training speed of kage.ppo.train with K runs packed in one process, at the spec's per-run hyperparameters
 (or the trainer flags given), with evaluation at the spec's defaults. For each K it trains K runs of one
 pair (seeds 1..K) for a few iterations after a warm-up, then evaluates once, and reports:
 - the aggregate training steps/s (K x 16,384 steps per iteration over the median iteration time);
@@ -23,13 +23,13 @@ from typing import Dict, List
 
 import torch
 
-from kage import train
+from kage.ppo import train
 
 PHASES = ("env", "forward", "update_forward", "backward", "optimizer")
 
 
 class PhaseTimer:
-    """Times the phases of kage.train's iterations (train's `timer("phase")` blocks) from the
+    """Times the phases of kage.ppo.train's iterations (train's `timer("phase")` blocks) from the
     `warmup`-th on, with CUDA events on the GPU (one synchronisation per iteration, at its end)."""
 
     def __init__(self, device: str, warmup: int):
@@ -112,7 +112,7 @@ def measure(base: train.Args, packs: int, warmup: int, iterations: int, workdir:
 
 def main(argv: List[str]) -> int:
     parser = argparse.ArgumentParser(prog="python3 -m kage.bench speed", description=__doc__.split("\n\n")[0],
-                                     epilog="Any other flag is a trainer flag (python3 -m kage.train --help).")
+                                     epilog="Any other flag is a trainer flag (python3 -m kage.ppo.train --help).")
     parser.add_argument("--packs", default="1,4,8,16,32", help="the K to measure, e.g. 1,4,8,16,32")
     parser.add_argument("--warmup", type=int, default=2, help="iterations before the timed ones")
     parser.add_argument("--iterations", type=int, default=3, help="timed iterations per K")

@@ -1,21 +1,15 @@
 """The benchmark report's tables: CSV and Markdown text of the three levels kage.bench.report computes,
 and their files (see its docstring for the protocol). Numbers in Markdown: mean ± SEM to 3 significant
 digits (at most 2 decimals); "-" where a value is missing, "n/a" for an undefined drop."""
-import csv
-import io
-import math
 import os
 from typing import List, Optional, Sequence
 
-from kage.files import atomic_write
+from kage.util.files import atomic_write
+from kage.util.tables import SUCCESS_NOTE, SUCCESS_SHOWN, csv_text, decimals, fmt_value, md_table
 
 METRICS = ("passed_distance", "progress", "success", "success_once", "return", "length", "jump_count")
-SUCCESS_SHOWN = "success_once"
 MARKDOWN_METRICS = (("success", SUCCESS_SHOWN), ("distance", "passed_distance"), ("progress", "progress"),
                     ("return", "return"))
-SUCCESS_NOTE = (f"success is `{SUCCESS_SHOWN}`: the share of episodes that reached the goal at some step, as in "
-                "the paper's success-rate plots; `success` (past the goal at the episode's end) is in the CSV and "
-                "JSON files.")
 RETURN_NOTE = ("The return is negative for most policies, so its drop is a percentage of a negative train return: "
                "read the gap.")
 NOTES = {SUCCESS_SHOWN: SUCCESS_NOTE, "return": RETURN_NOTE}
@@ -29,14 +23,6 @@ def value_cells(v: dict) -> list:
     diff = v["max_abs_diff"] or {}
     return [v["train"]["mean"], v["train"]["sem"], v["eval"]["mean"], v["eval"]["sem"], v["gap"], v["drop_pct"],
             diff.get("mean"), diff.get("sem")]
-
-
-def csv_text(header: Sequence[str], rows: List[list]) -> str:
-    out = io.StringIO()
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(header)
-    writer.writerows([["" if cell is None else cell for cell in row] for row in rows])
-    return out.getvalue()
 
 
 def pairs_csv(pairs: List[dict]) -> str:
@@ -64,17 +50,6 @@ def runs_csv(level1: List[dict]) -> str:
 
 # ---- Markdown ----
 
-def decimals(value: float) -> int:
-    """Three significant digits, at most two decimals (0.83, 12.3, 480, -3456)."""
-    if value == 0:
-        return 2
-    return min(2, max(0, 2 - math.floor(math.log10(abs(value)))))
-
-
-def fmt_value(value: Optional[float]) -> str:
-    return "-" if value is None else f"{value:.{decimals(value)}f}"
-
-
 def fmt_stat(stat: dict) -> str:
     """"0.83 ± 0.02": the SEM to the mean's decimals."""
     if stat["mean"] is None:
@@ -88,14 +63,6 @@ def fmt_drop(v: dict) -> str:
     if v["gap"] is None:
         return "-"
     return "n/a" if v["drop_pct"] is None else f"{v['drop_pct']:.1f} %"
-
-
-def md_table(header: Sequence[str], rows: List[Sequence[str]], text_columns: int) -> str:
-    """A Markdown table, its first `text_columns` columns left-aligned and the numbers right-aligned."""
-    def line(cells):
-        return "| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |"
-    rule = ["---"] * text_columns + ["---:"] * (len(header) - text_columns)
-    return "\n".join([line(header), line(rule)] + [line(r) for r in rows]) + "\n"
 
 
 def metric_title(name: str, metric: str) -> str:
@@ -175,7 +142,7 @@ def md_document(title: str, status: dict, body: str, protocol: str = PROTOCOL_TE
 
 def write_tables(out_dir: str, suite_name: str, levels: dict, status: dict, protocol: str = PROTOCOL_TEXT) -> List[str]:
     """The CSV and Markdown files; returns their names. `protocol` is the paragraph that says what a value is
-    (kage.evaluate's differs: one checkpoint instead of maxima over training)."""
+    (kage.ppo.evaluate's differs: one checkpoint instead of maxima over training)."""
     files = {"runs.csv": runs_csv(levels["runs"])}
     combined = []
     if levels["pairs"]:

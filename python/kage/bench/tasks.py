@@ -5,9 +5,9 @@ seeds and K, and DIR/tasks.json records it for `kage.bench status`."""
 import os
 from typing import Dict, List, Sequence, Tuple
 
-from kage.files import write_json
+from kage.util.files import write_json
 
-Job = Tuple[object, int, str]  # (run.Unit, seed, run directory)
+Job = Tuple[object, int, str]  # (units.Unit, seed, run directory)
 
 
 def run_dir(out: str, unit_name: str, seed: int) -> str:

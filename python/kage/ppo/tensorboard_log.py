@@ -7,7 +7,7 @@ import os
 import sys
 from typing import Dict, Optional
 
-from kage.evaluation import METRICS
+from kage.ppo.evaluation import METRICS
 
 TRAIN_COPIES = {"train/avg_progress": "main_metrics/avg_train_progress",
                 "train/avg_success_once": "main_metrics/avg_success_once"}
@@ -123,7 +123,7 @@ def open_writer(run_dir: str, args):
     writer_class = summary_writer_class()
     if writer_class is None:
         if not _told:
-            print("kage.train: tensorboard is not importable: no TensorBoard scalars (metrics.jsonl has every value)",
+            print("kage.ppo.train: tensorboard is not importable: no TensorBoard scalars (metrics.jsonl has every value)",
                   file=sys.stderr)
             _told = True
         return NoBoard()

@@ -26,12 +26,13 @@ from typing import Dict, List, Optional, Tuple
 
 import torch
 
-from kage import _kage
-from kage.files import atomic_write, safe, write_json
+from kage import front_end
+from kage.ppo import plugins
+from kage.util.files import atomic_write, safe, write_json
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
 # Arguments added since runs were first written, with the value that means what a run without them did.
-_ADDED_ARGUMENTS = {"agent": "kage.agent:nature_cnn", "augment": None, "video_every": 0}
+_ADDED_ARGUMENTS = {"agent": "kage.ppo.agent:nature_cnn", "augment": None, "video_every": 0}
 
 
 def code_version() -> str:
@@ -76,8 +77,8 @@ class RunDir:
         specs = {}
         for label, config in configs:
             if not os.path.exists(config):
-                raise SystemExit(f"kage.train: config '{config}' ({label}) not found")
-            specs[label] = json.loads(_kage.resolve(config, args.asset_root or ""))
+                raise SystemExit(f"kage.ppo.train: config '{config}' ({label}) not found")
+            specs[label] = front_end.resolve(config, args.asset_root)
         described = {label: {"path": config, "spec_sha256": specs[label]["sha256"]} for label, config in configs}
         run_json = os.path.join(path, "run.json")
         if os.path.exists(run_json):
@@ -91,7 +92,7 @@ class RunDir:
             for label, config in configs:
                 write_json(os.path.join(path, "configs", f"{safe(label)}.json"), specs[label])
                 if label != "train":
-                    certificate = json.loads(_kage.certify(args.train_config_path, config, args.asset_root or ""))
+                    certificate = front_end.certify(args.train_config_path, config, args.asset_root)
                     write_json(os.path.join(path, "certificates", f"{safe(label)}.json"), certificate)
             write_json(run_json, {
                 "kage_run": 1, "args": json_args(args), "argv": sys.argv, "configs": described,
@@ -101,6 +102,14 @@ class RunDir:
                 "derived": {"batch_size": args.batch_size, "minibatch_size": args.minibatch_size,
                             "num_iterations": args.num_iterations}})
         return cls(path, specs)
+
+    def check_env(self, label: str, env) -> None:
+        """Refuses a batch that runs another Spec than the one this directory records for `label` (its config
+        file changed between the two reads)."""
+        recorded = self.specs[label]["sha256"]
+        if env.spec_hash != recorded:
+            raise SystemExit(f"kage.ppo.train: config '{env.config}' ({label}) changed while {self.path} was opened "
+                             f"(spec {recorded[:12]} recorded, {env.spec_hash[:12]} in the environment): run again")
 
     # ---- the log ----
 
@@ -114,7 +123,7 @@ class RunDir:
         if bad:
             row = {k: None if k in bad else v for k, v in row.items()}
             if not self._warned_not_finite:
-                print(f"kage.train: warning: {self.path}: {', '.join(bad)} not finite at iteration "
+                print(f"kage.ppo.train: warning: {self.path}: {', '.join(bad)} not finite at iteration "
                       f"{row.get('iteration')}: the run has diverged; such values are logged as null",
                       file=sys.stderr, flush=True)
                 self._warned_not_finite = True
@@ -227,17 +236,19 @@ def check_same_run(path: str, previous: dict, args: dict, configs: dict) -> None
     for label, now in configs.items():
         before = previous["configs"].get(label)
         if before is None or before["path"] != now["path"]:
-            raise SystemExit(f"kage.train: {path} was started with other configs; use another --out")
+            raise SystemExit(f"kage.ppo.train: {path} was started with other configs; use another --out")
         if before["spec_sha256"] != now["spec_sha256"]:
             raise SystemExit(
-                f"kage.train: config '{now['path']}' ({label}) changed since {path} started (spec "
+                f"kage.ppo.train: config '{now['path']}' ({label}) changed since {path} started (spec "
                 f"{before['spec_sha256'][:12]} then, {now['spec_sha256'][:12]} now): restore it, or start a new run "
                 "with another --out")
     before = dict(_ADDED_ARGUMENTS, **previous["args"])
+    for key in ("agent", "augment"):  # module paths that moved name the same code
+        before[key] = plugins.current_reference(before.get(key))
     changed = sorted(k for k in args if k not in _RESUMABLE_CHANGES and before.get(k) != args[k])
     if changed:
         details = ", ".join(f"{k}: {before.get(k)!r} then, {args[k]!r} now" for k in changed)
-        raise SystemExit(f"kage.train: {path} was started with other arguments ({details}); "
+        raise SystemExit(f"kage.ppo.train: {path} was started with other arguments ({details}); "
                          "rerun with the original ones to resume, or use another --out")
 
 

@@ -1,6 +1,6 @@
 """Videos of a policy: one episode in a fresh environment, each frame shown with the episode's metrics
 beside it, written as an animated GIF (Pillow, Debian's python3-pil) or an MP4 (the ffmpeg program, where
-installed). Used by `python3 -m kage.evaluate --video` and by the trainer's --video-every (§3.6: sampled
+installed). Used by `python3 -m kage.ppo.evaluate --video` and by the trainer's --video-every (§3.6: sampled
 actions, from seed + iteration; one environment instead of the original's 3 x 3 tiles, one episode)."""
 import io
 import os
@@ -12,10 +12,10 @@ import numpy as np
 import torch
 
 import kage
-from kage.agent import autocast, sample_gumbel_max
-from kage.counter_random import CounterRandom
-from kage.files import atomic_write, safe
-from kage.wrappers import FrameStack
+from kage.ppo.counter_random import CounterRandom
+from kage.ppo.policy import policy_step
+from kage.ppo.wrappers import FrameStack
+from kage.util.files import atomic_write
 
 FPS = 25  # a GIF counts time in hundredths of a second: 40 ms a frame is exact
 PANEL_WIDTH = 190
@@ -58,12 +58,10 @@ def record_frames(agent, run: int, config: str, seed: int, title: str, *, device
         images, step = [], 0
         while True:
             x = stack.stack if stack else frame
-            with autocast(bf16):
-                logits, _ = agent(x[None].expand(runs, *x.shape))
-            logits = logits[run].float()
             uniform = random.uniform(0, counter.fill_(step), (1, num_actions))[0]
-            action = logits.argmax(-1) if greedy else sample_gumbel_max(logits, uniform)[0]
-            obs, _, _, _, info = env.step(action)
+            action, _, _ = policy_step(agent, x[None].expand(runs, *x.shape), uniform[None].expand(runs, -1, -1),
+                                       bf16=bf16, greedy=greedy)
+            obs, _, _, _, info = env.step(action[run])
             step += 1
             done = bool(host(info["_final"])[0])
             shown, fields = (info["final_obs"], info["final_info"]) if done else (obs, info)
@@ -116,21 +114,3 @@ def record(agent, run: int, config: str, seed: int, path: str, title: str, **opt
     images, length = record_frames(agent, run, config, seed, title, **options)
     write_video(path, images)
     return length
-
-
-def record_runs(agent, runs: list, args, iteration: int) -> None:
-    """The trainer's --video-every: at an evaluation point whose iteration is a multiple of it, an episode
-    of each run on each of its configs, <run dir>/videos/<label>_iter_<iteration>.gif."""
-    if not args.video_every or iteration % args.video_every:
-        return
-    from kage.train import configs_of
-    was_training = agent.training
-    agent.eval()
-    for k, run in enumerate(runs):
-        os.makedirs(os.path.join(run.dir.path, "videos"), exist_ok=True)
-        for label, config in configs_of(run.args):
-            record(agent, k, config, run.args.seed + iteration,
-                   os.path.join(run.dir.path, "videos", f"{safe(label)}_iter_{iteration}.gif"),
-                   f"{label} · iteration {iteration}", device=args.device, asset_root=args.asset_root,
-                   use_frame_stack=args.use_frame_stack, bf16=args.bf16, greedy=args.eval_greedy)
-    agent.train(was_training)

@@ -1,7 +1,6 @@
 """The PPO-CNN baseline's network and action distribution (kage-ppo-baseline.md §1), for a pack of K runs
 (K = 1 for a lone run): each run owns one group of every grouped convolution and one matrix of every
 batched linear layer, so one pass per layer evaluates all K."""
-import contextlib
 import math
 from typing import List
 
@@ -9,12 +8,7 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-from kage.space_to_depth import space_to_depth, weight_space_to_depth
-
-
-def autocast(bf16: bool):
-    """bfloat16 autocast for the network under --bf16, else nothing."""
-    return torch.autocast("cuda", dtype=torch.bfloat16) if bf16 else contextlib.nullcontext()
+from kage.ppo.fast.space_to_depth import space_to_depth, weight_space_to_depth
 
 
 def orthogonal(out_features: int, in_features: int, gain: float, device) -> torch.Tensor:
@@ -30,7 +24,10 @@ class Agent(nn.Module):
     every batched linear layer, so one pass per layer evaluates all K."""
 
     def __init__(self, seeds: List[int], channels: int = 3, height: int = 128, width: int = 128, device="cpu",
-                 num_actions: int = 8):
+                 num_actions: int = 8, *, bf16: bool = False, channels_last: bool = False, fused_input: bool = False,
+                 triton_conv: bool = False):
+        """The speed modes (--bf16, --channels-last, --fused-input, --triton-conv) change how the same parameters
+        are computed with, never the parameters: a checkpoint loads under any of them."""
         super().__init__()
         k = self.runs = len(seeds)
         self.conv1 = nn.Conv2d(k * channels, k * 32, 8, stride=4, groups=k, device=device)
@@ -44,12 +41,15 @@ class Agent(nn.Module):
         self.actor_bias = nn.Parameter(torch.zeros(k, 1, num_actions, device=device))
         self.critic_weight = nn.Parameter(torch.empty(k, 512, 1, device=device))
         self.critic_bias = nn.Parameter(torch.zeros(k, 1, 1, device=device))
-        self.input_dtype = torch.float32  # bfloat16 under --bf16
-        self.space_to_depth = False  # --fused-input
-        self.triton_conv = False  # --triton-conv (kage.triton_conv; with --fused-input)
+        self.input_dtype = torch.bfloat16 if bf16 else torch.float32
+        # The torso's one implementation for this network: cuDNN on the frames, cuDNN on 4x4 blocks (--fused-input),
+        # or kage.ppo.fast.triton_conv's kernels on 4x4 blocks (--triton-conv, which needs --fused-input).
+        self._torso = self._torso_triton if triton_conv else self._torso_blocks if fused_input else self._torso_frames
         with torch.no_grad():
             for run, seed in enumerate(seeds):
                 self._initialise(run, seed, channels)
+        if channels_last:
+            self.to(memory_format=torch.channels_last)
 
     def _initialise(self, run: int, seed: int, channels: int) -> None:
         """§1.3: orthogonal weights (gain sqrt 2 in the torso, 0.01 actor, 1 critic), zero biases; from the
@@ -68,18 +68,7 @@ class Agent(nn.Module):
         """uint8 [K, B, H, W, C] frames -> logits [K, B, A] and values [K, B]. The first operation is the
         conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups (under --triton-conv
         as a batch index)."""
-        k, b, h, w, c = obs.shape
-        if self.triton_conv:
-            x = self._torso_triton(obs)
-        else:
-            if self.space_to_depth:
-                x = F.relu(self._conv1_space_to_depth(obs))
-            else:
-                x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
-            x = F.relu(self.conv2(x))
-            x = F.relu(self.conv3(x))
-            x = x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
-        hidden = F.relu(torch.baddbmm(self.fc_bias, x, self.fc_weight))
+        hidden = F.relu(torch.baddbmm(self.fc_bias, self._torso(obs), self.fc_weight))
         # The heads always in float32, even under --bf16: values reach thousands (an untrained episode
         # returns about -3,900), where bfloat16's spacing is 16, more than a step's reward; rounded values
         # would bury the advantages in noise.
@@ -88,6 +77,21 @@ class Agent(nn.Module):
             logits = torch.baddbmm(self.actor_bias, hidden, self.actor_weight)
             value = torch.baddbmm(self.critic_bias, hidden, self.critic_weight).squeeze(-1)
         return logits, value
+
+    def _torso_frames(self, obs: torch.Tensor) -> torch.Tensor:
+        """The three convolutions on the frames, the runs as channel groups: [K, B, H, W, C] -> [K, B, flat]."""
+        k, b, h, w, c = obs.shape
+        x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
+        return self._conv2_conv3(x, k, b)
+
+    def _torso_blocks(self, obs: torch.Tensor) -> torch.Tensor:
+        """As _torso_frames, conv1 on the frames cut into 4x4 blocks (--fused-input)."""
+        k, b = obs.shape[:2]
+        return self._conv2_conv3(F.relu(self._conv1_space_to_depth(obs)), k, b)
+
+    def _conv2_conv3(self, x: torch.Tensor, k: int, b: int) -> torch.Tensor:
+        x = F.relu(self.conv3(F.relu(self.conv2(x))))
+        return x.reshape(b, k, self.flat).transpose(0, 1)  # each run's (channel, row, column) flatten
 
     def _input(self, frames: torch.Tensor) -> torch.Tensor:
         """uint8 [B, H, W, C'] -> [B, C', H, W] / 255 in the input dtype, channels last when the weights are.
@@ -114,7 +118,7 @@ class Agent(nn.Module):
         return F.conv2d(x, weight, self.conv1.bias, stride=1, groups=k)
 
     def _torso_triton(self, obs: torch.Tensor) -> torch.Tensor:
-        """The three convolutions on kage.triton_conv's kernels (--triton-conv): the runs as a batch index
+        """The three convolutions on kage.ppo.fast.triton_conv's kernels (--triton-conv): the runs as a batch index
         instead of channel groups, activations [K, B, H, W, C], the same parameters; conv1 on the frames cut
         into 4x4 blocks as under --fused-input. Returns [K, B, flat] in each run's (channel, row, column) order."""
         from kage import triton_conv  # here, not at the top: triton is needed only under the flag
@@ -131,63 +135,11 @@ class Agent(nn.Module):
         return tensor.unflatten(0, (self.runs, -1))
 
 
-def nature_cnn(observation_shape, num_actions: int, seeds: List[int], device) -> Agent:
-    """The baseline's network as a kage.plugins agent factory (the default of --agent)."""
+def nature_cnn(observation_shape, num_actions: int, seeds: List[int], device, **speed) -> Agent:
+    """The baseline's network as a kage.ppo.plugins agent factory (the default of --agent); `speed`: the
+    keyword arguments of Agent's speed modes."""
     height, width, channels = observation_shape
-    return Agent(seeds, channels, height, width, device, num_actions)
+    return Agent(seeds, channels, height, width, device, num_actions, **speed)
 
 
 nature_cnn.packable = True
-
-
-def sample_gumbel_max(logits: torch.Tensor, uniform: torch.Tensor):
-    """Categorical sampling by the Gumbel-max trick (§1.4): the action and its log-probability."""
-    action = torch.argmax(logits - torch.log(-torch.log(uniform)), dim=-1)
-    logprob = torch.log_softmax(logits.float(), dim=-1).gather(-1, action[..., None]).squeeze(-1)
-    return action, logprob
-
-
-def entropy_of(logits: torch.Tensor) -> torch.Tensor:
-    """Entropy from log-softmax logits clipped at the smallest float32, so p log p is never 0 * -inf."""
-    log_p = torch.log_softmax(logits, dim=-1).clamp(min=torch.finfo(logits.dtype).min)
-    return -(log_p.exp() * log_p).sum(-1)
-
-
-class RolloutPolicy:
-    """The rollout's policy step: forward, Gumbel-max sampling (§1.4) with the given uniforms, the
-    log-probability and the value. Under --cuda-graph it is captured once and replayed each step from
-    static input buffers."""
-
-    def __init__(self, policy, args, obs_shape, num_actions: int, device):
-        self.policy, self.args = policy, args
-        self.graph = None
-        if args.cuda_graph:
-            self.obs = torch.zeros(obs_shape, dtype=torch.uint8, device=device)
-            self.uniform = torch.full((*obs_shape[:2], num_actions), 0.5, device=device)
-            side = torch.cuda.Stream()
-            side.wait_stream(torch.cuda.current_stream())
-            with torch.cuda.stream(side), torch.no_grad():
-                for _ in range(3):  # warm-up: cuDNN picks its algorithms outside the capture
-                    self._step()
-            torch.cuda.current_stream().wait_stream(side)
-            self.graph = torch.cuda.CUDAGraph()
-            with torch.cuda.graph(self.graph), torch.no_grad():
-                self.outputs = self._step()
-
-    def _step(self):
-        with autocast(self.args.bf16):
-            logits, value = self.policy(self.obs)
-        action, logprob = sample_gumbel_max(logits.float(), self.uniform)
-        return action, logprob, value.float()
-
-    @torch.no_grad()
-    def __call__(self, obs: torch.Tensor, uniform: torch.Tensor):
-        """obs [K, N, H, W, C] uint8, uniform [K, N, A] in (0, 1) -> action, log-probability, value [K, N]."""
-        if self.graph is None:
-            self.obs, self.uniform = obs, uniform
-            return self._step()
-        self.obs.copy_(obs)
-        self.uniform.copy_(uniform)
-        self.graph.replay()
-        return self.outputs
-

@@ -3,7 +3,7 @@ training batches (--augment module:fn), each named as an importable `module:attr
 
 An agent factory is called as factory(observation_shape, num_actions, seeds, device), observation_shape
 being (H, W, C) of uint8 frames (C = 12 under --use-frame-stack), and returns a torch.nn.Module:
-- a packable factory (`factory.packable = True`, as kage.agent.nature_cnn) gets the seeds of the K runs of
+- a packable factory (`factory.packable = True`, as kage.ppo.agent.nature_cnn) gets the seeds of the K runs of
   a pack and returns one network for all of them: forward(uint8 [K, B, H, W, C]) -> (logits [K, B, A],
   values [K, B]), and run_view(tensor) splitting a parameter-shaped tensor into [K, ...] (each run's part);
 - any other factory gets one seed and returns a plain network: forward(uint8 [B, H, W, C]) -> (logits
@@ -23,18 +23,28 @@ from typing import Callable, List, Optional, Sequence
 import torch
 import torch.nn as nn
 
-BASELINE_AGENT = "kage.agent:nature_cnn"
+BASELINE_AGENT = "kage.ppo.agent:nature_cnn"
+# Modules of the package that moved: references written before (command lines, run.json) still name them.
+MOVED_MODULES = {"kage.agent": "kage.ppo.agent", "kage.augment": "kage.ppo.augment"}
+
+
+def current_reference(reference: Optional[str]) -> Optional[str]:
+    """`reference` with a moved module's old name replaced by its new one."""
+    if reference is None:
+        return None
+    module_name, colon, attribute = reference.partition(":")
+    return MOVED_MODULES.get(module_name, module_name) + colon + attribute
 
 
 def load(reference: str, flag: str) -> Callable:
     """The callable named by `module:attribute`, or a SystemExit naming the flag and the fix."""
-    module_name, _, attribute = reference.partition(":")
+    module_name, _, attribute = current_reference(reference).partition(":")
     if not module_name or not attribute:
-        raise SystemExit(f"kage.train: {flag} {reference!r}: write it as module:attribute (e.g. {BASELINE_AGENT})")
+        raise SystemExit(f"kage.ppo.train: {flag} {reference!r}: write it as module:attribute (e.g. {BASELINE_AGENT})")
     try:
         module = importlib.import_module(module_name)
     except ImportError as e:
-        raise SystemExit(f"kage.train: {flag} {reference}: cannot import '{module_name}' ({e}); put the directory "
+        raise SystemExit(f"kage.ppo.train: {flag} {reference}: cannot import '{module_name}' ({e}); put the directory "
                          "that holds it on PYTHONPATH") from None
     found = getattr(module, attribute, None)
     if not callable(found):
@@ -43,7 +53,7 @@ def load(reference: str, flag: str) -> Callable:
         what = "has no" if found is None else "has a non-callable"
         close = difflib.get_close_matches(attribute, names, n=1)
         hint = f"did you mean '{close[0]}'?" if close else f"it defines {', '.join(names) or 'no functions'}"
-        raise SystemExit(f"kage.train: {flag} {reference}: {module.__file__} {what} '{attribute}'; {hint}")
+        raise SystemExit(f"kage.ppo.train: {flag} {reference}: {module.__file__} {what} '{attribute}'; {hint}")
     return found
 
 
@@ -69,21 +79,22 @@ class LoneRun(nn.Module):
 
 
 def build_agent(reference: str, observation_shape: Sequence[int], num_actions: int, seeds: List[int],
-                device) -> nn.Module:
+                device, speed: Optional[dict] = None) -> nn.Module:
     """The network of `reference` for the runs of `seeds`, in the pack interface, checked on a batch of
-    two blank frames so that a wrong output shape is reported here, with what was expected."""
+    two blank frames so that a wrong output shape is reported here, with what was expected. `speed`: keyword
+    arguments for the baseline's factory (its speed modes, kage.ppo.agent.Agent); other factories get none."""
     factory = load(reference, "--agent")
     packable = is_packable(factory)
     if len(seeds) > 1 and not packable:
-        raise SystemExit(f"kage.train: --agent {reference} is not packable (its factory has no `packable = True`): "
+        raise SystemExit(f"kage.ppo.train: --agent {reference} is not packable (its factory has no `packable = True`): "
                          "train its runs one at a time (kage.bench run does so by itself)")
     torch.manual_seed(seeds[0])
-    net = factory(tuple(observation_shape), num_actions, list(seeds) if packable else seeds[:1], device)
+    net = factory(tuple(observation_shape), num_actions, list(seeds) if packable else seeds[:1], device, **(speed or {}))
     if not isinstance(net, nn.Module):
-        raise SystemExit(f"kage.train: --agent {reference} returned {type(net).__name__}, not a torch.nn.Module")
+        raise SystemExit(f"kage.ppo.train: --agent {reference} returned {type(net).__name__}, not a torch.nn.Module")
     if packable and not callable(getattr(net, "run_view", None)):
-        raise SystemExit(f"kage.train: --agent {reference} is packable but its network has no run_view(tensor) "
-                         "(see kage.agent.Agent.run_view)")
+        raise SystemExit(f"kage.ppo.train: --agent {reference} is packable but its network has no run_view(tensor) "
+                         "(see kage.ppo.agent.Agent.run_view)")
     agent = net if packable else LoneRun(net)
     K = len(seeds)
     blank = torch.zeros((K, 2, *observation_shape), dtype=torch.uint8, device=device)
@@ -92,7 +103,7 @@ def build_agent(reference: str, observation_shape: Sequence[int], num_actions: i
     if tuple(logits.shape) != (K, 2, num_actions) or tuple(value.shape) != (K, 2):
         shape = "[K, B, H, W, C] -> [K, B, A], [K, B]" if packable else "[B, H, W, C] -> [B, A], [B]"
         got = (logits.shape, value.shape) if packable else (logits.shape[1:], value.shape[1:])
-        raise SystemExit(f"kage.train: --agent {reference}: the network must map {shape} (A = {num_actions} "
+        raise SystemExit(f"kage.ppo.train: --agent {reference}: the network must map {shape} (A = {num_actions} "
                          f"actions); on a batch of 2 it returned logits {list(got[0])} and values {list(got[1])}")
     return agent
 
@@ -105,7 +116,7 @@ def load_augment(reference: Optional[str]) -> Optional[Callable]:
     try:
         inspect.signature(fn).bind(None, None)
     except TypeError:
-        raise SystemExit(f"kage.train: --augment {reference}: the function must take (obs, uniform); it takes "
+        raise SystemExit(f"kage.ppo.train: --augment {reference}: the function must take (obs, uniform); it takes "
                          f"{inspect.signature(fn)}") from None
     except ValueError:  # a builtin without a signature: trust it
         pass
@@ -114,7 +125,7 @@ def load_augment(reference: Optional[str]) -> Optional[Callable]:
 
 def augment_draws(random, stream: int, counter: torch.Tensor, optimizer_steps: int) -> Callable:
     """The uniform(shape) an augmentation draws from on one minibatch: each run's `stream` of `random` (a
-    kage.counter_random.CounterRandom), the counter naming the optimiser step and the draw, so a run draws
+    kage.ppo.counter_random.CounterRandom), the counter naming the optimiser step and the draw, so a run draws
     the same numbers alone, packed or resumed."""
     draws = 0
 

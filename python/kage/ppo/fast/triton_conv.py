@@ -10,7 +10,7 @@ import torch
 import triton
 import triton.language as tl
 
-from kage.space_to_depth import space_to_depth, weight_space_to_depth
+from kage.ppo.fast.space_to_depth import space_to_depth, weight_space_to_depth
 
 # Channel counts are 48/128/64 in (after space-to-depth) and 32/64/64 out; a program's output tile covers
 # the whole output width (BLOCK_N) in the forward pass and the weight gradient, so the configs tune the rest.

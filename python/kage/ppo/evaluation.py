@@ -1,19 +1,46 @@
 """The baseline's evaluation protocol and episode metrics (kage-ppo-baseline.md §3, §4): every run of a
 pack evaluated on its train config and each eval config at once, in fresh environments, and the
 metrics read from the finished episodes' final info."""
+import dataclasses
 import time
 from typing import Dict, List, Optional
 
 import torch
 
-import kage
-from kage.agent import Agent, autocast, sample_gumbel_max
-from kage.counter_random import CounterRandom
-from kage.wrappers import FrameStack
+from kage.ppo.counter_random import CounterRandom
+from kage.ppo.policy import policy_step
+from kage.ppo.wrappers import FrameStack
 
 METRICS = ("x", "y", "vx_mean", "vy_mean", "passed_distance", "progress", "jump_count", "success", "success_once")
 DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # §3.3
 TRAIN_OFFSET, EVAL_OFFSET, EVAL_OFFSET_STEP = 20_000, 10_000, 1_000  # §3.2
+
+
+@dataclasses.dataclass(frozen=True)
+class EvalSettings:
+    """How an evaluation is run (§3.2): finished episodes per config, whether the policy sees stacked frames,
+    and how it acts."""
+
+    episodes: int
+    frame_stack: bool = False
+    greedy: bool = False  # QUIRK off: sampled actions, as the original
+    bf16: bool = False
+
+
+@dataclasses.dataclass
+class EvalTargets:
+    """What one run is evaluated on: its seed and, by label ("train" first, then the eval configs), a batch of
+    fresh environments per config."""
+
+    seed: int
+    envs: Dict[str, "kage.VecEnv"]
+
+
+def evaluation_seed(run_seed: int, config_index: int, iteration: int) -> int:
+    """§3.2: the seed of a run's evaluation of its config_index-th config (0: the train config, offset 20,000;
+    i > 0: the i-th eval config, offset 10,000 + 1,000 (i - 1)) at `iteration`."""
+    offset = TRAIN_OFFSET if config_index == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * (config_index - 1)
+    return run_seed + offset + iteration
 
 
 class EpisodeMetrics:
@@ -38,8 +65,8 @@ class EpisodeMetrics:
 
 
 @torch.no_grad()
-def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]], dists: List[List[float]],
-             episodes: int, episode_length: int, args) -> List[List[Dict[str, Optional[float]]]]:
+def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
+             settings: EvalSettings) -> List[List[Dict[str, Optional[float]]]]:
     """The evaluations of each run's configs (§3.2; envs[k][c]: run k's c-th config), each in fresh
     environments with its own seed and sampling stream, all stepped together: one forward pass per step.
     Sampled actions until `episodes` episodes have finished in each. Steps are queued without a host
@@ -48,6 +75,8 @@ def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int
     after the waves (and steps on, a wave at a time, if one fell short)."""
     device = next(agent.parameters()).device
     flat_envs = [e for run in envs for e in run]
+    specs = [env.resolved_spec["config"] for env in flat_envs]
+    episode_length = max(c["episode_length"] for c in specs)
     configs, n, num_actions = len(envs[0]), flat_envs[0].num_envs, flat_envs[0].single_action_space.n
     random = CounterRandom([s for run in seeds for s in run], device)
     counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
@@ -55,8 +84,9 @@ def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int
     for env, seed in zip(flat_envs, [s for run in seeds for s in run]):
         infos.append(env.reset(seed=seed)[1])
     frames = [torch.from_dlpack(env.outputs()[0]) for env in flat_envs]
-    metrics = EpisodeMetrics(infos, [d for run in dists for d in run], device)
-    stack = FrameStack(torch.stack(frames)) if args.use_frame_stack else None
+    metrics = EpisodeMetrics(infos, [c["dist_to_success"] for c in specs], device)
+    stack = FrameStack(torch.stack(frames)) if settings.frame_stack else None
+    episodes = settings.episodes
     chunk = -(-episodes // n) * episode_length
     records, waves = [], 0
     while True:
@@ -64,12 +94,11 @@ def evaluate(agent: Agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int
         waves += 1
         for step in range(chunk):
             obs = stack.stack if stack else torch.stack(frames)             # [K * C, E, H, W, ch]
-            with autocast(args.bf16):
-                logits, _ = agent(obs.view(len(envs), configs * n, *obs.shape[2:]))
-            logits = logits.float().view(len(flat_envs), n, num_actions)
             # QUIRK: sampled, not greedy (Gumbel-max: an exact categorical sampler with no host check).
-            actions = logits.argmax(-1) if args.eval_greedy else sample_gumbel_max(logits, noise[:, step])[0]
-            for env, action in zip(flat_envs, actions):
+            actions, _, _ = policy_step(agent, obs.view(len(envs), configs * n, *obs.shape[2:]),
+                                        noise[:, step].reshape(len(envs), configs * n, num_actions),
+                                        bf16=settings.bf16, greedy=settings.greedy)
+            for env, action in zip(flat_envs, actions.view(len(flat_envs), n)):
                 env.step(action)
             if stack:
                 stack.push(torch.stack(frames), metrics.mask())
@@ -107,23 +136,20 @@ def absolute_difference(a: Optional[float], b: Optional[float]) -> Optional[floa
     return None if a is None or b is None else abs(a - b)
 
 
-def evaluation_rows(agent: Agent, runs: list, args, iteration: int, global_step: int) -> List[dict]:
-    """Evaluates each run's current parameters on its train config and on each eval config (§3.2; seed
-    offsets 20,000 for the train config, 10,000 + 1,000 i for the i-th eval config), and the absolute
-    differences train - eval (§3.3): one log row per run."""
+def evaluation_rows(agent, targets: List[EvalTargets], settings: EvalSettings, iteration: int,
+                    global_step: int) -> List[dict]:
+    """Evaluates each run's current parameters on its train config and on each eval config (§3.2, seeds by
+    evaluation_seed), and the absolute differences train - eval (§3.3): one log row per run."""
     start = time.perf_counter()
+    was_training = agent.training
     agent.eval()
-    seeds = [[r.args.seed + (TRAIN_OFFSET if i == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * (i - 1)) + iteration
-              for i in range(len(r.eval_envs))] for r in runs]
-    configs = [[r.specs[label]["config"] for label in r.eval_envs] for r in runs]
-    results = evaluate(agent, [list(r.eval_envs.values()) for r in runs], seeds,
-                       [[c["dist_to_success"] for c in run] for run in configs], args.eval_episodes,
-                       max(c["episode_length"] for run in configs for c in run), args)
-    agent.train()
+    seeds = [[evaluation_seed(t.seed, i, iteration) for i in range(len(t.envs))] for t in targets]
+    results = evaluate(agent, [list(t.envs.values()) for t in targets], seeds, settings)
+    agent.train(was_training)
     rows = []
-    for run, result in zip(runs, results):
+    for target, result in zip(targets, results):
         train, *evals = result
-        labels = list(run.eval_envs)[1:]
+        labels = list(target.envs)[1:]
         rows.append({"kind": "eval", "iteration": iteration, "global_step": global_step, "train": train,
                      "evals": dict(zip(labels, evals)),
                      "diffs": {label: {m: absolute_difference(train[m], ev[m]) for m in DIFF_METRICS}

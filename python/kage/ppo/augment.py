@@ -1,5 +1,5 @@
 """The example agent shipped beside the baseline: the baseline's network trained on randomly shifted
-frames (`--augment kage.augment:random_shift`), the common image augmentation for pixel RL (pad by 4
+frames (`--augment kage.ppo.augment:random_shift`), the common image augmentation for pixel RL (pad by 4
 pixels, replicating the border, then crop back to the frame size at a random offset; DrQ, RAD)."""
 import torch
 

@@ -1,0 +1,180 @@
+"""The baseline trainer's flags (kage-ppo-baseline.md §2.1: the defaults of the original's ppo_jax.py) as one
+dataclass whose fields are the command line, with the checks of their combinations and the configs a run
+trains and evaluates on."""
+import argparse
+import dataclasses
+import importlib.util
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from typing import List, Optional, Tuple
+
+from kage.ppo import plugins
+
+DESCRIPTION = ("PPO-CNN baseline of KAGE-Bench: train on one config, evaluate on it and on one or more others "
+               "(kage-ppo-baseline.md)")
+
+
+@dataclass
+class Args:
+    train_config_path: str = field(default="", metadata={"help": "the config to train on (YAML or kagec compile dir)"})
+    eval_config_path: Optional[str] = field(default=None, metadata={"help": "the config to evaluate on (ppo_jax.py)"})
+    eval_config_paths: List[str] = field(default_factory=list, metadata={
+        "help": "several configs to evaluate on (ppo_jax_multi_conf.py, spec 3.5)"})
+    eval_config_labels: List[str] = field(default_factory=list, metadata={
+        "help": "labels of the eval configs (default: their file names)"})
+    seed: int = field(default=1, metadata={"help": "seed of the run (spec 2.4)"})
+    device: str = field(default="cuda", metadata={"help": "cuda or cpu (environments and learner)"})
+    out: Optional[str] = field(default=None, metadata={
+        "help": "run directory (default runs/<exp-name>__<train config>__<seed>); an unfinished one resumes"})
+    exp_name: str = field(default="ppo_kage", metadata={"help": "name of the experiment"})
+    threads: Optional[int] = field(default=None, metadata={"help": "CPU threads (default: all cores)"})
+    asset_root: Optional[str] = field(default=None, metadata={"help": "resolve the configs' asset paths here"})
+    # Your own agent (kage.ppo.plugins)
+    agent: str = field(default=plugins.BASELINE_AGENT, metadata={
+        "help": "module:factory building the policy network (default: the baseline's Nature CNN)"})
+    augment: Optional[str] = field(default=None, metadata={
+        "help": "module:fn augmenting the update's minibatches, never evaluations (e.g. kage.ppo.augment:random_shift)"})
+    # PPO (§2.1: the defaults of ppo_jax.py; the benchmark overrides none)
+    total_timesteps: int = field(default=25_000_000, metadata={"help": "environment steps of the run"})
+    learning_rate: float = field(default=5e-4, metadata={"help": "Adam learning rate"})
+    num_envs: int = field(default=128, metadata={"help": "parallel training environments"})
+    num_steps: int = field(default=128, metadata={"help": "steps per environment per rollout"})
+    anneal_lr: bool = field(default=False, metadata={"help": "anneal the learning rate linearly (§2.6)"})
+    gamma: float = field(default=0.999, metadata={"help": "discount"})
+    gae_lambda: float = field(default=0.95, metadata={"help": "GAE lambda"})
+    num_minibatches: int = field(default=8, metadata={"help": "minibatches per epoch"})
+    update_epochs: int = field(default=3, metadata={"help": "epochs per update"})
+    norm_adv: bool = field(default=True, metadata={"help": "normalise advantages per minibatch"})
+    clip_coef: float = field(default=0.2, metadata={"help": "policy and value clipping"})
+    clip_vloss: bool = field(default=True, metadata={"help": "clipped value loss"})
+    ent_coef: float = field(default=0.01, metadata={"help": "entropy coefficient"})
+    ent_coef_anneal: bool = field(default=False, metadata={"help": "anneal the entropy coefficient (§2.6)"})
+    vf_coef: float = field(default=0.5, metadata={"help": "value loss coefficient"})
+    max_grad_norm: float = field(default=0.5, metadata={"help": "global gradient norm clip"})
+    normalize_reward: bool = field(default=False, metadata={"help": "per-environment reward normalisation"})
+    reward_clip_min: float = field(default=-math.inf, metadata={"help": "lower reward clip"})
+    reward_clip_max: float = field(default=math.inf, metadata={"help": "upper reward clip"})
+    use_frame_stack: bool = field(default=False, metadata={"help": "stack the last 4 frames (§1.1)"})
+    # Evaluation and checkpoints (§3)
+    run_eval_every: int = field(default=50, metadata={"help": "iterations between evaluations (0: none)"})
+    eval_episodes: int = field(default=128, metadata={"help": "episodes per config per evaluation"})
+    eval_num_envs: int = field(default=32, metadata={"help": "parallel environments of an evaluation"})
+    save_checkpoint_every: int = field(default=50, metadata={"help": "iterations between checkpoints (0: end only)"})
+    video_every: int = field(default=0, metadata={
+        "help": "record an episode per config (videos/<label>_iter_<i>.gif) at the evaluation points whose "
+                "iteration is a multiple of this (0: never)"})
+    # Corrections of the original's quirks (off: as the original)
+    bootstrap_truncation: bool = field(default=False, metadata={
+        "help": "bootstrap from the final observation at truncation (QUIRK off: truncation is termination)"})
+    eval_greedy: bool = field(default=False, metadata={"help": "greedy evaluation (QUIRK off: sampled actions)"})
+    # Speed (off: plain eager float32; see kage.bench speed)
+    bf16: bool = field(default=False, metadata={"help": "bfloat16 autocast for the network (GPU)"})
+    channels_last: bool = field(default=False, metadata={"help": "channels-last convolutions"})
+    cuda_graph: bool = field(default=False, metadata={"help": "replay the rollout's policy step as a CUDA graph"})
+    fused_input: bool = field(default=False, metadata={
+        "help": "one pass from uint8 frames to 4x4 blocks in the network's dtype; conv1 as the equal 2x2 conv"})
+    triton_conv: bool = field(default=False, metadata={
+        "help": "the convolutions as Triton implicit-GEMM kernels with the runs as a batch index, not cuDNN's "
+                "channel groups (needs --fused-input, CUDA and triton)"})
+
+    @property
+    def batch_size(self) -> int:
+        return self.num_envs * self.num_steps
+
+    @property
+    def minibatch_size(self) -> int:
+        return self.batch_size // self.num_minibatches
+
+    @property
+    def num_iterations(self) -> int:
+        return self.total_timesteps // self.batch_size
+
+
+# The arguments that differ between the runs of a pack; the others are the pack's, shared.
+PER_RUN = ("train_config_path", "eval_config_path", "eval_config_paths", "eval_config_labels", "seed", "out",
+           "exp_name")
+
+
+def parse_args(argv: Optional[List[str]] = None) -> Args:
+    """The flags of Args: --snake-case names, booleans as --flag / --no-flag."""
+    parser = argparse.ArgumentParser(prog="python3 -m kage.ppo.train", description=DESCRIPTION)
+    for f in dataclasses.fields(Args):
+        flag = "--" + f.name.replace("_", "-")
+        default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default
+        if f.type is bool:
+            parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=default, help=f.metadata["help"])
+        elif f.type == List[str]:
+            parser.add_argument(flag, nargs="+", default=default, help=f.metadata["help"])
+        else:
+            kind = next(t for t in (int, float, str) if f.type in (t, Optional[t]))
+            parser.add_argument(flag, type=kind, default=default, help=f.metadata["help"])
+    parser.add_argument("--pack", help="train the runs listed in this JSON file together (written by kage.bench)")
+    namespace = vars(parser.parse_args(argv))
+    pack = namespace.pop("pack")
+    if pack:
+        with open(pack) as f:
+            return [Args(**run) for run in json.load(f)["runs"]]
+    args = Args(**namespace)
+    problems = validate(args)
+    if problems:
+        parser.error("; ".join(problems))
+    return args
+
+
+def validate(args: Args) -> List[str]:
+    """What is wrong with a combination of flags, each with its fix."""
+    problems = []
+    if not args.train_config_path:
+        problems.append("--train-config-path is required")
+    if args.eval_config_path and args.eval_config_paths:
+        problems.append("give --eval-config-path or --eval-config-paths, not both")
+    if args.device not in ("cuda", "cpu"):
+        problems.append(f"--device {args.device}: use cuda or cpu")
+    if args.num_envs <= 0 or args.num_steps <= 0:
+        problems.append("--num-envs and --num-steps must be positive")
+    elif args.batch_size % args.num_minibatches:
+        problems.append(f"--num-minibatches {args.num_minibatches} must divide the batch (num_envs * num_steps "
+                        f"= {args.batch_size})")
+    elif args.num_iterations < 1:
+        problems.append(f"--total-timesteps {args.total_timesteps} is less than one batch ({args.batch_size})")
+    if args.run_eval_every < 0 or args.eval_episodes < 0 or args.eval_num_envs < 0:
+        problems.append("--run-eval-every, --eval-episodes and --eval-num-envs must not be negative")
+    n_evals = len(eval_paths(args))
+    if args.eval_config_labels and len(args.eval_config_labels) != n_evals:
+        problems.append(f"--eval-config-labels gives {len(args.eval_config_labels)} labels for {n_evals} eval configs")
+    if n_evals > 10:
+        problems.append("at most 10 eval configs (the 11th would reuse the train config's evaluation seeds, §3.5)")
+    if args.device == "cpu" and (args.bf16 or args.cuda_graph):
+        problems.append("--bf16 and --cuda-graph are for --device cuda")
+    if args.video_every < 0:
+        problems.append("--video-every must not be negative")
+    if args.agent != plugins.BASELINE_AGENT and (args.fused_input or args.channels_last or args.triton_conv):
+        problems.append("--fused-input, --channels-last and --triton-conv rewrite the baseline's network: drop them "
+                        "with --agent")
+    if args.triton_conv and args.device == "cpu":
+        problems.append("--triton-conv is for --device cuda")
+    if args.triton_conv and not args.fused_input:
+        problems.append("--triton-conv runs conv1 on --fused-input's 4x4 blocks: add --fused-input")
+    if args.triton_conv and importlib.util.find_spec("triton") is None:
+        problems.append("--triton-conv needs the triton package (it comes with PyTorch's CUDA builds): install it, "
+                        "or drop --triton-conv")
+    return problems
+
+
+def eval_paths(args: Args) -> List[str]:
+    return [args.eval_config_path] if args.eval_config_path else list(args.eval_config_paths)
+
+
+def configs_of(args: Args) -> List[Tuple[str, str]]:
+    """(label, path) of the configs a run evaluates on: "train" first, then the eval configs."""
+    return [("train", args.train_config_path)] + list(zip(eval_labels(args), eval_paths(args)))
+
+
+def eval_labels(args: Args) -> List[str]:
+    """Labels of the eval configs: given, or the file base name with spaces as underscores (§3.5)."""
+    labels = args.eval_config_labels or [os.path.basename(p.rstrip("/")).replace(" ", "_") for p in eval_paths(args)]
+    if len(set(labels)) != len(labels):
+        raise SystemExit(f"kage.ppo.train: eval configs share a label ({labels}); name them with --eval-config-labels")
+    return labels

@@ -1,0 +1,491 @@
+"""PPO-CNN baseline of KAGE-Bench, in PyTorch, on kage.make_vec: train on one config, evaluate on it and
+on one or more others, as the original's ppo_jax.py (and ppo_jax_multi_conf.py) do.
+
+    python3 -m kage.ppo.train --train-config-path T --eval-config-path E --seed S [--device cuda|cpu] [--out DIR]
+
+Read it top to bottom like CleanRL's ppo_atari_envpool.py: train() is the loop (rollout, GAE, update, log),
+and each other concern is a function of its own below it (the pack's runs, resume and checkpoints, the
+evaluation points, the log rows). The flags are kage.ppo.args, the losses kage.ppo.losses, the network
+kage.ppo.agent (§1), the policy step kage.ppo.policy, the evaluation and its metrics kage.ppo.evaluation (§3-4).
+"§x.y" refers to the section of the baseline specification (kage-ppo-baseline.md) that a line implements.
+Quirks of the original are kept by default and marked QUIRK; a flag offers the corrected behaviour where
+one makes sense:
+- truncation is treated as termination (no bootstrap across the 500-step limit): --bootstrap-truncation;
+- evaluation samples its actions: --eval-greedy takes the most likely action instead;
+- `success` is recomputed with a strict `>` at the terminal state, and the plots labelled "success rate"
+  show `success_once`: both are logged.
+Not offered: --target-kl (declared and never read by the original), Weights & Biases.
+
+Your own agent: --agent module:factory builds the network, --augment module:fn transforms the update's
+minibatches (kage.ppo.plugins); the rest of the protocol is the same for every agent. Videos: kage.ppo.video;
+TensorBoard scalars under the original's tags, where tensorboard is importable: kage.ppo.tensorboard_log.
+
+Packing: the loop trains K runs at once (K = 1 for a lone run; `kage.bench run --pack K`). Each run has its
+own parameters, optimizer state, random streams, environments and run directory, and follows the same
+algorithm as alone; tensors carry a leading run axis [K, ...], and one grouped forward and one backward
+per rollout step and per minibatch serve all K runs, so the learner's kernel launches do not grow with K.
+
+The environments and the learner share the device: observations, actions, rewards and episode metrics
+never leave it during a rollout or an evaluation; the host reads a few scalars once per iteration for
+the log. A run directory holds everything needed to resume a killed run exactly (kage.ppo.rundir).
+"""
+import contextlib
+import dataclasses
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional
+
+import torch
+
+import kage
+from kage.ppo import plugins, rundir, tensorboard_log, video
+from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args
+from kage.ppo.counter_random import CounterRandom
+from kage.ppo.evaluation import METRICS, EpisodeMetrics, EvalSettings, EvalTargets, evaluation_rows
+from kage.ppo.losses import clip_grad_norm_per_run, compute_gae, entropy_coefficient, entropy_of, ppo_loss
+from kage.ppo.policy import RolloutPolicy, autocast
+from kage.ppo.wrappers import FrameStack, RewardNormalizer
+from kage.util.files import safe
+from kage.util.stop import StopRequest
+
+ACTION_STREAM, SHUFFLE_STREAM = 1, 2  # the two random streams of a run (§2.4); evaluations use their own keys
+AUGMENT_STREAM = 3  # --augment's draws (not in the original)
+
+
+# ---- the training loop (§2.5) ----
+
+def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
+          stop: Optional[StopRequest] = None) -> List["Run"]:
+    """Trains the runs of `pack` together (one for a lone run) to the end, or `stop_after` iterations past
+    where they start (kage.bench speed). Resumes each run from its checkpoint if it has one. Once `stop` is
+    requested (a signal), checkpoints after the running iteration and exits."""
+    args = check_pack(pack)
+    stop = stop or StopRequest("kage.ppo.train", "")
+    timer = timer or NoTimer()
+    device, threads = choose_device(args)
+    runs = [open_run(a, threads) for a in pack]
+    K, T, N = len(runs), args.num_steps, args.num_envs
+    height, width, channels = runs[0].env.single_observation_space.shape
+    channels *= 4 if args.use_frame_stack else 1
+    num_actions = runs[0].env.single_action_space.n
+    agent = plugins.build_agent(args.agent, (height, width, channels), num_actions, [a.seed for a in pack], device,
+                                speed_modes(args))  # §2.4: the runs' seeds
+    augment = plugins.load_augment(args.augment)
+    agent_spec = {"agent": args.agent, "observation_shape": [height, width, channels], "num_actions": num_actions,
+                  "use_frame_stack": args.use_frame_stack}  # what kage.ppo.evaluate needs to rebuild a run's policy
+    optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5)
+    random = CounterRandom([a.seed for a in pack], device)
+    counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
+    settings = EvalSettings(args.eval_episodes, args.use_frame_stack, args.eval_greedy, args.bf16)
+
+    # Rollout storage, [T, K, N, ...] on the device (§2.5 step 1d).
+    obs = torch.zeros((T, K, N, height, width, channels), dtype=torch.uint8, device=device)
+    actions = torch.zeros((T, K, N), dtype=torch.long, device=device)
+    logprobs, rewards, dones, values = (torch.zeros((T, K, N), device=device) for _ in range(4))
+
+    # Views of the runtime's buffers, which every step rewrites in place.
+    infos = [run.env.reset(seed=kage.env_seeds(run.args.seed, N))[1] for run in runs]
+    outputs = [run.env.outputs() for run in runs]
+    frames = [torch.from_dlpack(o[0]) for o in outputs]
+    env_reward, env_terminated, env_truncated = ([torch.from_dlpack(o[i]) for o in outputs] for i in (1, 2, 3))
+    final_frames = [torch.from_dlpack(info["final_obs"]) for info in infos]
+    specs = [run.env.resolved_spec["config"] for run in runs]
+    episode = EpisodeMetrics(infos, [spec["dist_to_success"] for spec in specs], device)
+    stack = FrameStack(torch.stack(frames)) if args.use_frame_stack else None
+    normalizer = RewardNormalizer((K, N), args.gamma, device) if args.normalize_reward else None
+    state = LoopState.start(K, N, device)
+    boards = [tensorboard_log.open_writer(run.dir.path, run.args) for run in runs]
+
+    def observe() -> torch.Tensor:
+        """The runs' current observations, [K, N, H, W, C]."""
+        return stack.stack if stack else torch.stack(frames)
+
+    if resume(runs, agent, optimizer, state, stack, normalizer, boards, device):
+        pass
+    elif runs[0].eval_envs:
+        with timer("eval"):  # §3.1: the untrained policy
+            evaluation_point(agent, runs, boards, settings, args, 0, 0)
+
+    progress = rundir.Progress(args.num_iterations, args.batch_size * K)
+    start_iteration = state.iteration + 1
+    last_iteration = args.num_iterations if stop_after is None else min(args.num_iterations,
+                                                                        start_iteration + stop_after - 1)
+    rollout = RolloutPolicy(agent, observe().shape, num_actions, device, bf16=args.bf16, cuda_graph=args.cuda_graph)
+    # Episodes end only by truncation at episode_length (§2.3): when no episode is shorter than a rollout, an
+    # environment ends at most one per rollout, and its final info still holds it when the rollout is over,
+    # so the episode metrics are read once per rollout instead of after every step.
+    read_once = min(spec["episode_length"] for spec in specs) >= T
+    finished_at = torch.zeros((T, K, N), device=device)
+
+    for iteration in range(start_iteration, last_iteration + 1):
+        iteration_start = time.perf_counter()
+        if args.anneal_lr:  # §2.6
+            optimizer.param_groups[0]["lr"] = args.learning_rate * (1.0 - (iteration - 1.0) / args.num_iterations)
+        episode_sums = torch.zeros((K, len(METRICS) + 1), device=device)  # count, then the nine metrics
+        # The action stream's draws for the whole rollout; the counter names the iteration, so a run draws the
+        # same numbers alone, packed or resumed.
+        noise = random.uniform(ACTION_STREAM, counter.fill_(iteration - 1), (T, N, num_actions))
+
+        for step in range(T):  # §2.5 step 1
+            with timer("forward"):
+                if stack:
+                    obs[step] = stack.stack
+                else:
+                    torch.stack(frames, out=obs[step])  # the runtime's frames straight into the rollout buffer
+                dones[step] = state.next_done
+                action, logprob, value = rollout(obs[step], noise[:, step])
+                values[step], actions[step], logprobs[step] = value, action, logprob
+            with timer("env"):
+                for run, a in zip(runs, action):
+                    run.env.step(a)
+                reward = torch.stack(env_reward)
+                state.next_done = (torch.stack(env_terminated) | torch.stack(env_truncated)).float()  # QUIRK (§2.5 b)
+                finished = finished_at[step] = episode.mask()
+                if not read_once:
+                    episode_sums += state.tally(episode.rows(), finished)
+                if args.bootstrap_truncation:
+                    with torch.no_grad(), autocast(args.bf16):  # the value of the observation the truncation discarded
+                        truncated = torch.stack(env_truncated).float() * finished
+                        final = torch.stack(final_frames)
+                        if stack:  # the final frame on top of the episode's last stack
+                            final = torch.cat([stack.stack[..., final.shape[-1]:], final], -1)
+                        reward = reward + args.gamma * agent(final)[1].float() * truncated
+                if normalizer:
+                    reward = normalizer(reward, state.next_done)
+                rewards[step] = reward.clamp(args.reward_clip_min, args.reward_clip_max)
+                if stack:
+                    stack.push(torch.stack(frames), state.next_done)
+        if read_once:
+            with timer("env"):
+                episode_sums += state.tally(episode.rows(), finished_at.sum(0))
+        state.global_step += args.batch_size  # §2.5 step 2
+
+        with torch.no_grad(), timer("forward"):  # §2.5 step 3
+            with autocast(args.bf16):
+                next_value = agent(observe())[1].float()
+            advantages, returns = compute_gae(rewards, values, dones, next_value, state.next_done, args.gamma,
+                                              args.gae_lambda)
+
+        # §2.5 step 4: E epochs of M minibatches over each run's flattened (time-major) batch.
+        b_obs = obs.transpose(0, 1).reshape(K, T * N, height, width, channels)
+        b_logprobs, b_actions, b_advantages, b_returns, b_values = (
+            t.transpose(0, 1).reshape(K, T * N) for t in (logprobs, actions, advantages, returns, values))
+        runs_axis = torch.arange(K, device=device)[:, None]
+        for epoch in range(args.update_epochs):
+            ent_coef = entropy_coefficient(args, state.optimizer_steps)
+            counter.fill_((iteration - 1) * args.update_epochs + epoch)
+            permutation = random.permutation(SHUFFLE_STREAM, counter, args.batch_size)  # [K, B]
+            for start in range(0, args.batch_size, args.minibatch_size):
+                mb = permutation[:, start:start + args.minibatch_size]
+                with timer("update_forward"):
+                    mb_obs = b_obs[runs_axis, mb]
+                    if augment:  # the update's minibatch only: the rollout and evaluations see plain frames
+                        draws = plugins.augment_draws(random, AUGMENT_STREAM, counter, state.optimizer_steps)
+                        mb_obs = augment(mb_obs, draws)
+                    with autocast(args.bf16):
+                        logits, new_value = agent(mb_obs)
+                    logits, new_value = logits.float(), new_value.float()
+                    new_logprob = torch.log_softmax(logits, -1).gather(-1, b_actions[runs_axis, mb, None]).squeeze(-1)
+                    loss, pg_loss, v_loss, entropy, approx_kl, clipfrac = ppo_loss(
+                        new_logprob, entropy_of(logits), new_value, b_logprobs[runs_axis, mb], b_values[runs_axis, mb],
+                        b_advantages[runs_axis, mb], b_returns[runs_axis, mb], args, ent_coef)
+                with timer("backward"):
+                    optimizer.zero_grad()
+                    loss.sum().backward()  # the runs' losses are independent: each gradient is its run's own
+                with timer("optimizer"):
+                    clip_grad_norm_per_run(agent, args.max_grad_norm)
+                    optimizer.step()
+                state.optimizer_steps += 1
+
+        # §2.5 step 5, §4.3: losses of the last minibatch, named; the host reads them once.
+        var_returns = b_returns.var(1, unbiased=False)
+        explained_var = 1 - (b_returns - b_values).var(1, unbiased=False) / (var_returns + 1e-8)
+        measured = {"value_loss": v_loss, "policy_loss": pg_loss, "entropy": entropy, "approx_kl": approx_kl,
+                    "clipfrac": clipfrac, "loss": loss, "explained_variance": explained_var,
+                    "var_returns": var_returns, **state.stored_episodes(), "episode_sums": episode_sums}
+        timer.end_iteration()
+        iteration_seconds = time.perf_counter() - iteration_start
+        state.train_seconds += iteration_seconds
+        state.iteration = iteration
+        rows = train_rows(to_host(measured), iteration, state.global_step, state.train_seconds, iteration_seconds, args,
+                          optimizer.param_groups[0]["lr"], ent_coef)
+        eval_rows = []
+        if runs[0].eval_envs and (iteration % args.run_eval_every == 0 or iteration == last_iteration):
+            with timer("eval"):  # §2.5 step 6, and §3.1's final point
+                eval_rows = evaluation_point(agent, runs, boards, settings, args, iteration, state.global_step,
+                                             train_rows=rows)
+        else:
+            for run, board, row in zip(runs, boards, rows):
+                board.write(run.dir.log(row))
+        if (args.save_checkpoint_every > 0 and iteration % args.save_checkpoint_every == 0) or \
+                iteration == args.num_iterations or stop.requested:  # §2.5 step 7, at the end, and when asked
+            save_checkpoints(runs, agent, optimizer, state, stack, normalizer, agent_spec)
+        progress.update(iteration, state.global_step * K, {"charts/SPS": state.global_step * K / state.train_seconds},
+                        eval_rows[0] if eval_rows else None)
+        if stop.requested and iteration < last_iteration:
+            print(f"kage.ppo.train: stopped after iteration {iteration} of {args.num_iterations}, checkpointed; "
+                  "run the same command again to resume", file=sys.stderr, flush=True)
+            raise SystemExit(stop.exit_code)
+
+    if last_iteration == args.num_iterations:
+        for run in runs:
+            run.dir.finish(run.history)
+            print(f"kage.ppo.train: done, {run.dir.path}/summary.json", file=sys.stderr)
+    for run, board in zip(runs, boards):
+        for env in [run.env, *run.eval_envs.values()]:
+            env.close()
+        board.close()
+    return runs
+
+
+# ---- the runs of a pack ----
+
+@dataclass
+class Run:
+    """What a run owns besides its slice of the network: its arguments, directory and environments."""
+    args: Args
+    dir: rundir.RunDir
+    env: "kage.VecEnv"
+    eval_envs: Dict[str, "kage.VecEnv"]  # "train", then the eval configs by label
+    history: List[dict] = field(default_factory=list)
+
+
+def open_run(args: Args, threads: int) -> Run:
+    """The run's directory (created or checked before anything else is written), then its batches, each
+    checked to run the Spec the directory records."""
+    run_dir = rundir.RunDir.open(args, configs_of(args))
+    env = kage.make_vec(args.train_config_path, args.num_envs, device=args.device, seed=args.seed,
+                        asset_root=args.asset_root, threads=threads)
+    run_dir.check_env("train", env)
+    eval_envs = {}
+    if args.run_eval_every > 0 and args.eval_episodes > 0 and args.eval_num_envs > 0:
+        for label, path in configs_of(args):
+            eval_envs[label] = kage.make_vec(path, args.eval_num_envs, device=args.device, asset_root=args.asset_root,
+                                             threads=threads)
+            run_dir.check_env(label, eval_envs[label])
+    return Run(args, run_dir, env, eval_envs)
+
+
+def check_pack(runs: List[Args]) -> Args:
+    """The pack's shared arguments: every run must agree on all but PER_RUN and on the number of eval configs."""
+    first = dataclasses.asdict(runs[0])
+    for args in runs[1:]:
+        other = dataclasses.asdict(args)
+        differ = [k for k in first if k not in PER_RUN and first[k] != other[k]]
+        if differ:
+            raise SystemExit(f"kage.ppo.train: packed runs must share {', '.join(differ)}")
+        if len(eval_paths(args)) != len(eval_paths(runs[0])):
+            raise SystemExit("kage.ppo.train: packed runs must evaluate the same number of configs")
+    return runs[0]
+
+
+def choose_device(args: Args):
+    """The learner's device and CPU thread count, with the GPU's math settings."""
+    if args.device == "cuda" and not torch.cuda.is_available():
+        raise SystemExit("kage.ppo.train: --device cuda, but torch sees no GPU: use --device cpu")
+    threads = args.threads or os.cpu_count() or 1
+    torch.set_num_threads(threads)
+    if args.device == "cuda":
+        torch.backends.cudnn.benchmark = True
+        torch.set_float32_matmul_precision("high")  # TF32, as JAX's default precision on this GPU
+    return torch.device(args.device), threads
+
+
+def speed_modes(args: Args) -> Optional[dict]:
+    """The baseline network's speed modes from the flags (none for another --agent, which validate() ensures)."""
+    if args.agent != plugins.BASELINE_AGENT:
+        return None
+    return {"bf16": args.bf16, "channels_last": args.channels_last, "fused_input": args.fused_input,
+            "triton_conv": args.triton_conv}
+
+
+class NoTimer:
+    """The phases of an iteration, timed only by kage.bench speed (kage.bench.speed.PhaseTimer)."""
+
+    def __call__(self, phase: str):
+        return contextlib.nullcontext()
+
+    def end_iteration(self) -> None:
+        pass
+
+
+# ---- what the loop carries across iterations, and its checkpoints ----
+
+@dataclass
+class LoopState:
+    """The loop's counters and each environment's episode bookkeeping (§4.2), [K, N] or [K]: what a checkpoint
+    holds besides parameters, optimizer, environments, frame stack and reward normaliser."""
+    next_done: torch.Tensor
+    last_return: torch.Tensor  # §4.2: each environment's most recent episode
+    last_length: torch.Tensor
+    any_finished: torch.Tensor
+    iteration: int = 0  # the last finished
+    global_step: int = 0
+    optimizer_steps: int = 0
+    train_seconds: float = 0.0
+
+    TENSORS = ("next_done", "last_return", "last_length", "any_finished")
+
+    @classmethod
+    def start(cls, K: int, N: int, device) -> "LoopState":
+        zeros = lambda: torch.zeros((K, N), device=device)  # noqa: E731
+        return cls(zeros(), zeros(), zeros(), torch.zeros(K, dtype=torch.bool, device=device))
+
+    def tally(self, rows: torch.Tensor, finished: torch.Tensor) -> torch.Tensor:
+        """§4.2: records each environment's latest return and length; returns the finished episodes' count and
+        metric sums [K, 1 + 9] to add to the iteration's."""
+        self.last_return = torch.where(finished > 0, rows[:, 1], self.last_return)
+        self.last_length = torch.where(finished > 0, rows[:, 2], self.last_length)
+        self.any_finished.logical_or_(finished.any(1))
+        return torch.cat([finished.sum(1, keepdim=True), (rows[:, 3:] * finished[:, None]).sum(2)], 1)
+
+    def stored_episodes(self) -> Dict[str, torch.Tensor]:
+        """§4.3: the mean of the stored returns and lengths over the environments that have one, [K] each."""
+        stored = self.last_return != 0
+        count = stored.sum(1).clamp(min=1)
+        return {"episodic_return": torch.where(stored, self.last_return, 0).sum(1) / count,
+                "episodic_length": torch.where(stored, self.last_length, 0).sum(1) / count,
+                "any_finished": self.any_finished.float()}
+
+
+def save_checkpoints(runs: List[Run], agent, optimizer, state: LoopState, stack, normalizer, agent_spec: dict) -> None:
+    """Each run's checkpoint (kage.ppo.rundir): its parameters and optimizer state, its environments' state, and
+    its part of the loop state."""
+    for k, run in enumerate(runs):
+        checkpoint = {
+            "iteration": state.iteration, "global_step": state.global_step, "optimizer_steps": state.optimizer_steps,
+            "train_seconds": state.train_seconds,
+            "agent": {n: agent.run_view(p)[k].detach().cpu().clone() for n, p in agent.named_parameters()},
+            "optimizer": rundir.optimizer_run_state(optimizer, agent, k), "env_state": run.env.save_state(),
+            "frame_stack": stack.stack[k].cpu() if stack else None,
+            "normalizer": {n: v[k].cpu() for n, v in normalizer.state_dict().items()} if normalizer else None,
+            "history": run.history, "agent_spec": dict(agent_spec, seed=run.args.seed)}
+        checkpoint.update({key: getattr(state, key)[k].cpu() for key in LoopState.TENSORS})
+        run.dir.save_checkpoint(checkpoint)
+
+
+def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalizer, boards, device) -> bool:
+    """Loads the runs' checkpoints, if they have any, into the network, optimizer, environments and loop state;
+    whether they had."""
+    checkpoints = [run.dir.load_checkpoint(device) for run in runs]
+    if all(c is None for c in checkpoints):
+        return False
+    if any(c is None or c["iteration"] != checkpoints[0]["iteration"] for c in checkpoints):
+        raise SystemExit("kage.ppo.train: packed runs resume together from checkpoints of one iteration; "
+                         "pack them by the iteration they reached")
+    for k, (run, c) in enumerate(zip(runs, checkpoints)):
+        with torch.no_grad():
+            for name, p in agent.named_parameters():
+                agent.run_view(p)[k].copy_(c["agent"][name])
+        run.env.load_state(c["env_state"])
+        for key in LoopState.TENSORS:
+            getattr(state, key)[k] = c[key].to(device)
+        if stack:
+            stack.stack[k] = c["frame_stack"].to(device)
+        if normalizer:
+            for name, value in c["normalizer"].items():
+                getattr(normalizer, name)[k] = value.to(device)
+        run.history = c["history"]
+        boards[k].purge(c["global_step"])
+    rundir.load_optimizer(optimizer, agent, [c["optimizer"] for c in checkpoints])
+    c = checkpoints[0]
+    state.iteration, state.global_step = c["iteration"], c["global_step"]
+    state.optimizer_steps, state.train_seconds = c["optimizer_steps"], c["train_seconds"]
+    for run in runs:
+        print(f"kage.ppo.train: resuming {run.dir.path} after iteration {c['iteration']}", file=sys.stderr)
+    return True
+
+
+# ---- evaluation points and the log ----
+
+def evaluation_point(agent, runs: List[Run], boards, settings: EvalSettings, args: Args, iteration: int,
+                     global_step: int, train_rows: Optional[List[dict]] = None) -> List[dict]:
+    """§2.5 step 6: evaluates every run (kage.ppo.evaluation), logs each run's training row (if any) and
+    evaluation row to metrics.jsonl and TensorBoard, and records the videos that --video-every asks for."""
+    eval_rows = evaluation_rows(agent, [EvalTargets(run.args.seed, run.eval_envs) for run in runs], settings,
+                                iteration, global_step)
+    for k, (run, board, row) in enumerate(zip(runs, boards, eval_rows)):
+        logged = [run.dir.log(train_rows[k])] if train_rows else []
+        run.history.append(run.dir.log(row))
+        board.write(*logged, row)
+    record_videos(agent, runs, args, iteration)
+    return eval_rows
+
+
+def record_videos(agent, runs: List[Run], args: Args, iteration: int) -> None:
+    """--video-every: at an evaluation point whose iteration is a multiple of it, an episode of each run on
+    each of its configs, <run dir>/videos/<label>_iter_<iteration>.gif (kage.ppo.video)."""
+    if not args.video_every or iteration % args.video_every:
+        return
+    was_training = agent.training
+    agent.eval()
+    for k, run in enumerate(runs):
+        os.makedirs(os.path.join(run.dir.path, "videos"), exist_ok=True)
+        for label, config in configs_of(run.args):
+            video.record(agent, k, config, run.args.seed + iteration,
+                         os.path.join(run.dir.path, "videos", f"{safe(label)}_iter_{iteration}.gif"),
+                         f"{label} · iteration {iteration}", device=args.device, asset_root=args.asset_root,
+                         use_frame_stack=args.use_frame_stack, bf16=args.bf16, greedy=args.eval_greedy)
+    agent.train(was_training)
+
+
+def to_host(measured: Dict[str, torch.Tensor]) -> List[Dict[str, object]]:
+    """Named device values ([K] each, or [K, n]) as one host read: a dict of Python numbers (or lists) per run."""
+    names = list(measured)
+    columns = [measured[n].float().reshape(measured[n].shape[0], -1) for n in names]
+    widths = [c.shape[1] for c in columns]
+    host = torch.cat(columns, 1).tolist()
+    rows = []
+    for values in host:
+        row, at = {}, 0
+        for name, width, column in zip(names, widths, columns):
+            row[name] = values[at] if measured[name].dim() == 1 else values[at:at + width]
+            at += width
+        rows.append(row)
+    return rows
+
+
+def train_rows(measured: List[Dict[str, object]], iteration: int, global_step: int, train_seconds: float,
+               iteration_seconds: float, args: Args, learning_rate: float, ent_coef: float) -> List[dict]:
+    """Each run's training log row (§4.3) from its measured values: losses, explained variance (where the
+    returns vary), the stored episodes' return and length (once one finished), and the mean of each metric
+    over the episodes that finished in the iteration."""
+    rows = []
+    for m in measured:
+        row = {"kind": "train", "iteration": iteration, "global_step": global_step,
+               "charts/learning_rate": learning_rate, "charts/entropy_coef": ent_coef,
+               "charts/SPS": global_step / train_seconds, "charts/SPS_update": args.batch_size / iteration_seconds}
+        row.update({f"losses/{name}": m[name] for name in
+                    ("value_loss", "policy_loss", "entropy", "approx_kl", "clipfrac", "loss")})
+        if m["var_returns"] > 0:
+            row["train/explained_variance"] = m["explained_variance"]
+        if m["any_finished"]:
+            row["train/avg_completed_episodic_return"] = m["episodic_return"]
+            row["train/avg_completed_episodic_length"] = m["episodic_length"]
+        count, *sums = m["episode_sums"]
+        if count > 0:
+            row.update({f"train/avg_{metric}": total / count for metric, total in zip(METRICS, sums)})
+        rows.append(row)
+    return rows
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    parsed = parse_args(argv)
+    pack = parsed if isinstance(parsed, list) else [parsed]
+    unfinished = []
+    for args in pack:
+        run_dir = rundir.RunDir.open(args, configs_of(args))
+        if run_dir.finished:
+            print(f"kage.ppo.train: {run_dir.path} is finished (summary.json); nothing to do", file=sys.stderr)
+        else:
+            unfinished.append(args)
+    if unfinished:
+        with StopRequest("kage.ppo.train", "finishing this iteration, then checkpointing and exiting") as stop:
+            train(unfinished, stop=stop)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

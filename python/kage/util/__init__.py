@@ -1,0 +1,1 @@
+"""Helpers every layer uses: atomic file writes, signal handling for child processes, text tables."""
