@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One device-machine call for "your own agent": the baseline and the example agent (the baseline trained
-# with kage.augment:random_shift) side by side on background/1 for the same number of steps
+# with kage.ppo.augment:random_shift) side by side on background/1 for the same number of steps
 # (TOTAL_TIMESTEPS, default 1,703,936 as bench/train_device.sh; SEEDS, default 1; PACK, default 1), each
 # through `python3 -m kage.bench run` into its own directory, then `kage.bench report` on each. The two
 # reports' tables and a side-by-side pairs table (compare.md) come back under $OUT. Run with carry [".deps"]:
@@ -11,7 +11,7 @@ root=/tmp/kage-agents
 rm -rf "$root"
 for agent in baseline random_shift; do
   extra=()
-  [[ $agent == random_shift ]] && extra=(--augment kage.augment:random_shift)
+  [[ $agent == random_shift ]] && extra=(--augment kage.ppo.augment:random_shift)
   python3 -m kage.bench run suites/kage_bench.yaml --pairs background/1 --seeds "${SEEDS:-1}" --pack "${PACK:-1}" \
     --out "$root/$agent" --device cuda --total-timesteps "${TOTAL_TIMESTEPS:-1703936}" "${extra[@]}" "$@" \
     2>&1 | tee "$OUT/run_$agent.log"

@@ -14,7 +14,7 @@ fast=(--bf16 --channels-last --fused-input)
 for set in fp32 fast; do
   flags=()
   [[ $set == fast ]] && flags=("${fast[@]}")
-  python3 -m kage.train --train-config-path configs/kage_bench/bases/shape_black.yaml \
+  python3 -m kage.ppo.train --train-config-path configs/kage_bench/bases/shape_black.yaml \
     --eval-config-path configs/kage_bench/background/1-eval.yaml --seed 1 --out "$dir/lone-$set" \
     "${common[@]}" "${flags[@]}" >"$dir-lone-$set.log" 2>&1 &
   python3 -m kage.bench run suites/kage_bench.yaml --pairs background/1 agent_appearance/1 --seeds 1-2 \

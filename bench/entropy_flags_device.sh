@@ -9,7 +9,7 @@ rm -rf "$dir"
 for flag in fp32 bf16 channels-last fused-input; do
   extra=()
   [[ $flag != fp32 ]] && extra=("--$flag")
-  python3 -m kage.train --train-config-path configs/kage_bench/bases/shape_black.yaml \
+  python3 -m kage.ppo.train --train-config-path configs/kage_bench/bases/shape_black.yaml \
     --eval-config-path configs/kage_bench/background/1-eval.yaml --seed 1 --out "$dir/$flag" --device cuda \
     --total-timesteps "${STEPS:-2621440}" --run-eval-every 40 "${extra[@]}" >"$dir-$flag.log" 2>&1 &
 done

@@ -12,7 +12,7 @@ rm -rf "$dir"
 common=(--device cuda --total-timesteps "$steps" --run-eval-every 40)
 while IFS='|' read -r name flags; do
   # shellcheck disable=SC2086
-  python3 -m kage.train --train-config-path configs/kage_bench/bases/shape_black.yaml \
+  python3 -m kage.ppo.train --train-config-path configs/kage_bench/bases/shape_black.yaml \
     --eval-config-path configs/kage_bench/background/1-eval.yaml --seed 1 --out "$dir/lone-$name" \
     "${common[@]}" $flags >"$dir-lone-$name.log" 2>&1 &
 done <<'SETS'

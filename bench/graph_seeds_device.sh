@@ -9,7 +9,7 @@ dir=/tmp/kage-graph-seeds
 rm -rf "$dir"
 for seed in 2 3 4; do
   for graph in no-cuda-graph cuda-graph; do
-    python3 -m kage.train --train-config-path configs/kage_bench/bases/shape_black.yaml \
+    python3 -m kage.ppo.train --train-config-path configs/kage_bench/bases/shape_black.yaml \
       --eval-config-path configs/kage_bench/background/1-eval.yaml --seed "$seed" --out "$dir/$graph-$seed" \
       --device cuda --total-timesteps 983040 --run-eval-every 30 "--$graph" >"$dir-$graph-$seed.log" 2>&1 &
   done

@@ -9,7 +9,7 @@ import argparse
 import torch
 
 from cuda_timing import median_ms
-from kage.agent import Agent
+from kage.ppo.agent import Agent
 
 VARIANTS = [  # (bf16, channels_last, fused_input, triton_conv)
     (False, False, False, False), (False, False, True, False), (True, False, True, False), (True, True, False, False),
@@ -18,12 +18,8 @@ VARIANTS = [  # (bf16, channels_last, fused_input, triton_conv)
 
 def minibatch_ms(k: int, minibatch: int, bf16: bool, channels_last: bool, fused: bool, triton_conv: bool,
                  profile: bool) -> float:
-    agent = Agent(list(range(k)), device="cuda")
-    if channels_last:
-        agent = agent.to(memory_format=torch.channels_last)
-    agent.input_dtype = torch.bfloat16 if bf16 else torch.float32
-    agent.space_to_depth = fused
-    agent.triton_conv = triton_conv
+    agent = Agent(list(range(k)), device="cuda", bf16=bf16, channels_last=channels_last, fused_input=fused,
+                  triton_conv=triton_conv)
     optimizer = torch.optim.Adam(agent.parameters(), lr=5e-4, eps=1e-5)
     obs = torch.randint(0, 256, (k, minibatch, 128, 128, 3), dtype=torch.uint8, device="cuda")
 

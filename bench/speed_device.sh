@@ -10,5 +10,5 @@ while IFS='|' read -r packs flags; do
   [ -z "$packs" ] && continue
   # shellcheck disable=SC2086
   python3 -m kage.bench speed --packs "$packs" --device cuda --json "$OUT/speed.jsonl" $flags 2>&1 |
-    grep -v '^iteration\|^kage.train' | tee -a "$OUT/speed.log"
+    grep -v '^iteration\|^kage.ppo.train' | tee -a "$OUT/speed.log"
 done <<<"$SETS"
