@@ -1,30 +1,19 @@
-"""Checks python/kage/triton_conv.py's packed convolutions (Triton implicit-GEMM kernels, the run as a grid
-axis) against cuDNN's grouped convolutions and times them on the NatureCNN torso against cuDNN in
-channels-last bf16, the trainer's fastest variant. Needs torch with CUDA and triton only: the module is
-imported without the kage package's __init__ (which loads the C++ extension).
-
-usage: python3 bench/triton_conv_check.py [--profile]
-
-Exits non-zero if any check fails. The fp32 checks allow 1e-3: tl.dot rounds fp32 operands to TF32 (10-bit
+"""kage.ppo.fast.triton_conv's packed convolutions (Triton implicit-GEMM kernels, the run as a grid axis) against
+cuDNN's grouped convolutions, forward and the input, weight and bias gradients, for the NatureCNN's three layers at
+K = 3 and 8 packed runs, in fp32 and bf16. The fp32 checks allow 1e-3: tl.dot rounds fp32 operands to TF32 (10-bit
 mantissa). The bf16 checks allow 2e-2 (outputs rounded to bf16). Errors are max |got - want| / max |want|.
-"""
+`python3 tests/gpu/test_triton_conv.py [--profile]` also times the torso against cuDNN channels-last bf16."""
 import argparse
 import pathlib
 import sys
-import types
 
+import pytest
 import torch
 import torch.nn.functional as F
 import triton
 
-from cuda_timing import median_ms
-
-# The kage package without its __init__ (which loads the C++ extension): its modules import as usual.
-_KAGE = types.ModuleType("kage")
-_KAGE.__path__ = [str(pathlib.Path(__file__).resolve().parent.parent / "python" / "kage")]
-sys.modules["kage"] = _KAGE
-from kage import space_to_depth as s2d  # noqa: E402
-from kage import triton_conv as tc  # noqa: E402
+from kage.ppo.fast import space_to_depth as s2d
+from kage.ppo.fast import triton_conv as tc
 
 # NatureCNN's convolutions on 128 x 128 x 3 frames: (name, input side, in channels, out channels, kernel, stride).
 LAYERS = [("conv1", 128, 3, 32, 8, 4), ("conv2", 31, 32, 64, 4, 2), ("conv3", 14, 64, 64, 3, 1)]
@@ -121,13 +110,29 @@ def print_profile(name: str, step) -> None:
     print(prof.key_averages().table(sort_by="cuda_time_total", row_limit=12, max_name_column_width=70))
 
 
+def full_fp32_references() -> None:
+    torch.backends.cudnn.benchmark = True
+    torch.backends.cudnn.allow_tf32 = False  # the fp32 references in full fp32
+    torch.backends.cuda.matmul.allow_tf32 = False
+
+
+@pytest.mark.parametrize("k, b", [(3, 64), (8, 2048)])
+@pytest.mark.parametrize("dtype, tolerance", [(torch.float32, 1e-3), (torch.bfloat16, 2e-2)])
+@pytest.mark.parametrize("layer", LAYERS, ids=[layer[0] for layer in LAYERS])
+def test_packed_conv_equals_grouped_conv(k, b, dtype, tolerance, layer):
+    full_fp32_references()
+    assert check_layer(k, b, layer, dtype, tolerance) == 0
+    torch.cuda.empty_cache()
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--profile", action="store_true", help="print the top CUDA kernels of one torso step of each")
     a = p.parse_args()
-    torch.backends.cudnn.benchmark = True
-    torch.backends.cudnn.allow_tf32 = False  # the fp32 references in full fp32
-    torch.backends.cuda.matmul.allow_tf32 = False
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
+    from cuda_timing import median_ms  # the lab notebook's timer
+
+    full_fp32_references()
     print(f"{torch.cuda.get_device_name()}, torch {torch.__version__}, triton {triton.__version__}", flush=True)
     failures = 0
     for k, b in ((3, 64), (8, 2048)):

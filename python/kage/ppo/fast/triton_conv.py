@@ -4,7 +4,7 @@ are never materialised (cuDNN runs grouped convolutions group by group with slic
 moved more bytes than it saved: bench/results/2026-11-23-h100-packed-training-speed.md). Activations are
 [K, B, H, W, C] (NHWC per run); the parameters keep nn.Conv2d(groups=K)'s layout, so checkpoints are the
 same. Imported only under --triton-conv: triton is a GPU-machine dependency. Checked and timed by
-bench/triton_conv_check.py.
+tests/gpu/test_triton_conv.py.
 """
 import torch
 import triton
