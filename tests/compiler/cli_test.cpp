@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include "compiler/driver/commands.h"
+#include "driver/commands.h"
 #include "test_support.h"
 
 namespace kage::test {

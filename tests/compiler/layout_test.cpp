@@ -1,7 +1,9 @@
 // The dependency rules of docs/architecture.md, checked on the #include lines of the source tree:
-// the front end's early stages include nothing from runtime/, only the driver reaches the
-// verification code, and no source includes bench/.
+// no arrow points up (runtime/ <- compiler/ <- api/, verify/ <- driver/), the front end's early stages
+// include nothing from runtime/, only the driver reaches the verification code, and no source includes
+// bench/.
 #include <catch2/catch.hpp>
+#include <initializer_list>
 #include <regex>
 #include <string>
 #include <vector>
@@ -31,6 +33,21 @@ std::vector<std::pair<std::string, std::string>> project_includes(const std::str
 
 bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
+/// The includes under `dirs` of a path starting with one of `above`, one "file:line: path" a line;
+/// `seen` counts every include scanned.
+std::string includes_of(std::initializer_list<const char*> dirs, std::initializer_list<const char*> above,
+                        size_t& seen) {
+  std::string report;
+  for (const char* dir : dirs) {
+    for (const auto& [where, path] : project_includes(dir)) {
+      ++seen;
+      for (const char* prefix : above)
+        if (starts_with(path, prefix)) report += where + ": " + path + "\n";
+    }
+  }
+  return report;
+}
+
 }  // namespace
 
 TEST_CASE("basic, parse, sema and analysis include no runtime code", "[layout][one-source-of-truth]") {
@@ -50,14 +67,32 @@ TEST_CASE("basic, parse, sema and analysis include no runtime code", "[layout][o
   CHECK(offenders.empty());
 }
 
+TEST_CASE("the runtime includes nothing from the compiler, the API, verify/ or the driver", "[layout]") {
+  size_t seen = 0;
+  const std::string report =
+      includes_of({"runtime"}, {"compiler/", "api/", "include/", "kage/", "verify/", "driver/"}, seen);
+  INFO("includes of the layers above the runtime:\n" << report);
+  CHECK(seen > 150);  // the scan found the runtime's own includes
+  CHECK(report.empty());
+}
+
+TEST_CASE("the compiler includes nothing from the API, verify/ or the driver", "[layout]") {
+  size_t seen = 0;
+  // The public header (include/kage/kage.h) is the API's face, so it is above the compiler too.
+  const std::string report = includes_of({"compiler"}, {"api/", "include/", "kage/", "verify/", "driver/"}, seen);
+  INFO("includes of the layers above the compiler:\n" << report);
+  CHECK(seen > 80);
+  CHECK(report.empty());
+}
+
 TEST_CASE("only the driver includes verify/, and nothing includes bench/", "[layout]") {
   size_t seen = 0;
   std::vector<std::string> offenders;
-  for (const char* dir : {"compiler", "api", "runtime", "verify"}) {
+  for (const char* dir : {"compiler", "api", "runtime", "verify", "driver"}) {
     for (const auto& [where, path] : project_includes(dir)) {
       ++seen;
       const bool in_verify = starts_with(where, "verify/");
-      const bool in_driver = starts_with(where, "compiler/driver/");
+      const bool in_driver = starts_with(where, "driver/");
       if (starts_with(path, "verify/") && !in_verify && !in_driver) offenders.push_back(where + ": " + path);
       if (starts_with(path, "bench/")) offenders.push_back(where + ": " + path);
     }

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "compiler/driver/commands.h"
+#include "driver/commands.h"
 #include "fileio/image_io.h"
 #include "tests/integration/integration_support.h"
 

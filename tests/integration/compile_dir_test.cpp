@@ -9,7 +9,7 @@
 
 #include <unistd.h>
 
-#include "compiler/driver/commands.h"
+#include "driver/commands.h"
 #include "kage/kage.h"
 #include "tests/integration/integration_support.h"
 

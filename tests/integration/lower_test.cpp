@@ -5,10 +5,10 @@
 #include <sstream>
 
 #include "api/environment.h"
-#include "compiler/driver/commands.h"
 #include "compiler/lower/lower.h"
 #include "compiler/sema/resolve.h"
 #include "compiler/sema/schema.h"
+#include "driver/commands.h"
 #include "tests/integration/integration_support.h"
 
 namespace {

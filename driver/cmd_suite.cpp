@@ -5,7 +5,7 @@
 
 #include "compiler/analysis/suite.h"
 #include "compiler/basic/file_out.h"
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 #include "verify/isolation/isolation.h"
 
 namespace kage {

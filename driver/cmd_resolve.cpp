@@ -2,7 +2,7 @@
 #include <ostream>
 
 #include "compiler/basic/file_out.h"
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 
 namespace kage {
 

@@ -1,5 +1,5 @@
 // Dispatch over the command table.
-#include "compiler/driver/commands.h"
+#include "driver/commands.h"
 
 #include <ostream>
 

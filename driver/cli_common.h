@@ -7,7 +7,7 @@
 
 #include "compiler/basic/diag.h"
 #include "compiler/basic/file_out.h"
-#include "compiler/driver/commands.h"
+#include "driver/commands.h"
 #include "compiler/lower/load_lowered.h"
 #include "compiler/sema/resolve.h"
 

@@ -3,7 +3,7 @@
 #include <ostream>
 #include <sstream>
 
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 #include "compiler/sema/schema.h"
 
 namespace kage {

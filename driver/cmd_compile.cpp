@@ -9,7 +9,7 @@
 #include "compiler/codegen/build.h"
 #include "compiler/codegen/codegen.h"
 #include "compiler/codegen/compiled_dir.h"
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 #include "runtime/io/specialized_assets.h"
 
 namespace kage {

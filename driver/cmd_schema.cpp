@@ -1,7 +1,7 @@
 // kagec schema [--suite]: the embedded JSON Schema of configs or suite manifests, for editors.
 #include <ostream>
 
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 #include "compiler/sema/schema.h"
 
 namespace kage {

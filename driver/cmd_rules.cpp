@@ -1,7 +1,7 @@
 // kagec rules: every diagnostic rule of compiler/basic/diag_rules.def with its severity.
 #include <ostream>
 
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 
 namespace kage {
 

@@ -4,7 +4,7 @@
 #include <iostream>
 #include <new>
 
-#include "compiler/driver/commands.h"
+#include "driver/commands.h"
 
 int main(int argc, char** argv) {
   kage::CommandIo io{std::cout, std::cerr, isatty(STDERR_FILENO) != 0};

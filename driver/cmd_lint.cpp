@@ -1,7 +1,7 @@
 // kagec lint FILE...: every diagnostic of the front end, as text or JSON, with a count.
 #include <ostream>
 
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 
 namespace kage {
 

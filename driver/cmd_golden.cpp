@@ -6,7 +6,7 @@
 #include <ostream>
 #include <unistd.h>
 
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 #include "compiler/lower/load_lowered.h"
 #include "verify/golden/golden_check.h"
 

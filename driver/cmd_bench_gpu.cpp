@@ -17,7 +17,7 @@
 #include "compiler/analysis/suite.h"
 #include "compiler/codegen/build.h"
 #include "compiler/codegen/codegen.h"
-#include "compiler/driver/cmd_bench_gpu.h"
+#include "driver/cmd_bench_gpu.h"
 #include "compiler/lower/lower.h"
 #include "runtime/io/asset_pack.h"
 #include "verify/bench/gpu_measure.h"

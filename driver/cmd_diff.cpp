@@ -3,7 +3,7 @@
 
 #include "compiler/analysis/diff.h"
 #include "compiler/basic/file_out.h"
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 
 namespace kage {
 namespace {

@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "api/environment.h"
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 #include "runtime/io/gif_writer.h"
 #include "fileio/image_io.h"
 #include "runtime/rng.h"

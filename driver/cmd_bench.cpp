@@ -5,8 +5,8 @@
 #include <thread>
 
 #include "api/environment.h"
-#include "compiler/driver/cli_common.h"
-#include "compiler/driver/cmd_bench_gpu.h"
+#include "driver/cli_common.h"
+#include "driver/cmd_bench_gpu.h"
 #include "runtime/rng.h"
 
 namespace kage {

@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "compiler/driver/cli_common.h"
-#include "compiler/driver/commands.h"
+#include "driver/cli_common.h"
+#include "driver/commands.h"
 
 namespace kage {
 

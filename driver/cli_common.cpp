@@ -1,5 +1,5 @@
 // CLI11 glue shared by the commands.
-#include "compiler/driver/cli_common.h"
+#include "driver/cli_common.h"
 
 #include <ostream>
 
