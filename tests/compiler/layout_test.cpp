@@ -1,7 +1,7 @@
 // The dependency rules of docs/architecture.md, checked on the #include lines of the source tree:
 // no arrow points up (runtime/ <- compiler/ <- api/, verify/ <- driver/), the front end's early stages
 // include nothing from runtime/, only the driver reaches the verification code, and no source includes
-// bench/.
+// lab/ (the lab notebook).
 #include <catch2/catch.hpp>
 #include <initializer_list>
 #include <regex>
@@ -85,7 +85,7 @@ TEST_CASE("the compiler includes nothing from the API, verify/ or the driver", "
   CHECK(report.empty());
 }
 
-TEST_CASE("only the driver includes verify/, and nothing includes bench/", "[layout]") {
+TEST_CASE("only the driver includes verify/, and nothing includes lab/", "[layout]") {
   size_t seen = 0;
   std::vector<std::string> offenders;
   for (const char* dir : {"compiler", "api", "runtime", "verify", "driver"}) {
@@ -94,7 +94,7 @@ TEST_CASE("only the driver includes verify/, and nothing includes bench/", "[lay
       const bool in_verify = starts_with(where, "verify/");
       const bool in_driver = starts_with(where, "driver/");
       if (starts_with(path, "verify/") && !in_verify && !in_driver) offenders.push_back(where + ": " + path);
-      if (starts_with(path, "bench/")) offenders.push_back(where + ": " + path);
+      if (starts_with(path, "lab/")) offenders.push_back(where + ": " + path);
     }
   }
   std::string report;

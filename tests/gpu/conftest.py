@@ -1,4 +1,4 @@
-"""GPU tests of the Python package: run on a machine with a CUDA GPU (bench/python_device.sh), never
+"""GPU tests of the Python package: run on a machine with a CUDA GPU (lab/tools/python_device.sh), never
 in CI. A missing GPU or torch without CUDA stops the run with an error, not a skip."""
 import pathlib
 import sys

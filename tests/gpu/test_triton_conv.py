@@ -129,7 +129,7 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--profile", action="store_true", help="print the top CUDA kernels of one torso step of each")
     a = p.parse_args()
-    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "bench"))
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "lab" / "tools"))
     from cuda_timing import median_ms  # the lab notebook's timer
 
     full_fp32_references()
