@@ -1,0 +1,231 @@
+"""kage.jax's environment: ``reset`` and ``step`` as pure functions of a state pytree, each one typed XLA
+FFI call (``kage/jax/_ffi.py``), so that ``jax.jit``, ``lax.scan`` and ``jax.vmap`` take them whole."""
+import dataclasses
+import os
+from typing import Any, Dict, Tuple, Union
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from kage import spaces, vector
+from kage.jax import _ffi, _native
+from kage.jax.seeds import env_seed_words
+
+_INFO_NAMES = tuple(name for name, _, _ in vector.INFO_FIELDS)
+_FINAL_KEYS = ("final_obs", "final_info", "_final", "_final_obs", "_final_info")
+
+
+@dataclasses.dataclass(frozen=True)
+class KageState:
+    """Everything a batch of environments needs to continue: the parts of ``kage.VecEnv.save_state``'s
+    format (seeds, latent and visual states, layouts) plus the last finished episodes' final observation
+    and info and the out-of-range action record. Only 8- and 32-bit arrays (JAX's default has no 64-bit
+    types). Its ``spec_hash`` is static (pytree metadata): a state of one config is refused by another.
+
+    - ``seeds`` uint32 [N, 2]: each environment's 64-bit seed as (low, high) words;
+    - ``latent``, ``segments``, ``visual`` uint8 [N, bytes]: the runtime's state structs and layouts;
+    - ``final_obs``, ``final_info``: see ``JaxEnv.step``;
+    - ``steps`` int32 []: steps since the reset;
+    - ``action_error`` int32 [N, 2]: per environment, (value, step) of its first action outside 0..7,
+      (0, 0) while there is none; ``JaxEnv.check`` raises it.
+    """
+
+    seeds: Any
+    latent: Any
+    segments: Any
+    visual: Any
+    final_obs: Any
+    final_info: Dict[str, Any]
+    steps: Any
+    action_error: Any
+    spec_hash: str
+
+
+_ARRAY_FIELDS = ("seeds", "latent", "segments", "visual", "final_obs", "final_info", "steps", "action_error")
+jax.tree_util.register_dataclass(KageState, data_fields=list(_ARRAY_FIELDS), meta_fields=["spec_hash"])
+
+
+class JaxEnv:
+    """``num_envs`` environments of one config as two pure functions:
+
+    ``reset(seed) -> (state, obs, info)`` and ``step(state, actions) -> (state, obs, reward, terminated,
+    truncated, info)``, with the names, shapes and dtypes of ``kage.make_vec``'s outputs: obs uint8
+    [N, H, W, 3], reward float32 [N], flags and masks as make_vec gives them, info the fields of
+    ``kage.INFO_FIELDS`` plus the same-step autoreset keys ``final_obs``, ``final_info``, ``_final``,
+    ``_final_obs`` and ``_final_info``.
+
+    Same-step autoreset, as make_vec: a step that ends an episode returns its reward and flags, the next
+    episode's first observation and info, and the finished episode's last observation and info in
+    ``final_obs`` / ``final_info`` where ``_final`` is true. Rows where ``_final`` is false hold that
+    environment's previous final observation and info (zeros until its first episode ends): the state
+    carries them, so a step writes only the rows that finish.
+    """
+
+    metadata = {"autoreset_mode": "same-step"}
+
+    def __init__(self, config: str, num_envs: int, sizes: Dict[str, Any], dtypes: Dict[str, Any]):
+        self.config = config
+        self.num_envs = num_envs
+        self.spec_hash = sizes["spec_hash"]
+        height, width = sizes["height"], sizes["width"]
+        self.single_observation_space = spaces.observation_space(height, width)
+        self.single_action_space = spaces.action_space()
+        n = num_envs
+        sd = jax.ShapeDtypeStruct
+        self._obs = sd((n, height, width, 3), dtypes["obs"])
+        self._info = {name: sd((n,), dtypes[name]) for name in _INFO_NAMES}
+        flag = sd((n,), dtypes["flag"])
+        self._outputs = [self._obs, sd((n,), dtypes["reward"]), flag, flag, sd((n,), dtypes["final"])]
+        self._state = KageState(
+            seeds=sd((n, 2), jnp.uint32), latent=sd((n, sizes["latent_bytes"]), jnp.uint8),
+            segments=sd((n, sizes["segment_bytes"]), jnp.uint8), visual=sd((n, sizes["visual_bytes"]), jnp.uint8),
+            final_obs=self._obs, final_info=dict(self._info), steps=sd((), jnp.int32),
+            action_error=sd((n, 2), jnp.int32), spec_hash=self.spec_hash)
+
+    # ---- the two calls ----
+
+    def reset(self, seed) -> Tuple[KageState, Any, Dict[str, Any]]:
+        """Starts episode 0 of every environment. ``seed``: a non-negative Python int, or a uint32 JAX
+        scalar (traced or not); environment i gets ``kage.env_seeds(seed, num_envs)[i]``, as
+        ``kage.make_vec``'s ``reset(seed=seed)`` gives it."""
+        words = self._seed_words(seed)
+        s = self._state
+        outs = _ffi.reset_call([s.latent, s.segments, s.visual, *self._outputs, *self._info.values()])(
+            words, spec_hash=self.spec_hash)
+        latent, segments, visual, obs, _, _, _, final_mask = outs[:8]
+        info = dict(zip(_INFO_NAMES, outs[8:]))
+        state = KageState(
+            seeds=words, latent=latent, segments=segments, visual=visual,
+            final_obs=jnp.zeros(self._obs.shape, self._obs.dtype),
+            final_info={name: jnp.zeros(a.shape, a.dtype) for name, a in self._info.items()},
+            steps=jnp.int32(0), action_error=jnp.zeros((self.num_envs, 2), jnp.int32), spec_hash=self.spec_hash)
+        return state, obs, self._with_final(info, state, final_mask)
+
+    def step(self, state: KageState, actions) -> Tuple[KageState, Any, Any, Any, Any, Dict[str, Any]]:
+        """One step of every environment with ``actions``: int32 [num_envs], each in 0..7 (bit 0 left,
+        bit 1 right, bit 2 jump). A value outside 0..7 is recorded in the state (``check`` raises it) and
+        the step runs with its low 3 bits, as the runtime masks any action (spec 3.2)."""
+        self._check_state(state)
+        actions = self._check_actions(actions)
+        s = self._state
+        finals = [state.final_info[name] for name in _INFO_NAMES]
+        outs = _ffi.step_call([s.latent, s.segments, s.visual, s.final_obs, *self._outputs, s.latent, s.segments,
+                               s.visual, *self._info.values(), *self._info.values()])(
+            state.seeds, state.latent, state.segments, state.visual, state.final_obs, actions, *finals,
+            spec_hash=self.spec_hash)
+        latent, segments, visual, final_obs, obs, reward, terminated, truncated, final_mask = outs[:9]
+        k = len(_INFO_NAMES)
+        final_info = dict(zip(_INFO_NAMES, outs[12:12 + k]))
+        info = dict(zip(_INFO_NAMES, outs[12 + k:]))
+        steps = state.steps + 1
+        bad = (actions < 0) | (actions > 7)
+        first = bad & (state.action_error[:, 1] == 0)
+        record = jnp.stack([actions, jnp.broadcast_to(steps, actions.shape)], axis=1)
+        new = KageState(seeds=state.seeds, latent=latent, segments=segments, visual=visual, final_obs=final_obs,
+                        final_info=final_info, steps=steps,
+                        action_error=jnp.where(first[:, None], record, state.action_error), spec_hash=self.spec_hash)
+        return new, obs, reward, terminated, truncated, self._with_final(info, new, final_mask)
+
+    def check(self, state: KageState) -> None:
+        """Raises ValueError if any step since the reset had an action outside 0..7 (naming the first);
+        call it outside ``jit`` (it reads the [N, 2] record from the device), e.g. after a scan. A state with
+        leading vmap axes is checked whole."""
+        self._check_state(state, batched=True)
+        record = np.asarray(jax.device_get(state.action_error))
+        hits = np.argwhere(record[..., 1] != 0)
+        if hits.size == 0:
+            return
+        steps = record[..., 1][tuple(hits.T)]
+        where = tuple(hits[np.lexsort((np.arange(len(hits)), steps))[0]])
+        value, step = record[where]
+        batch = f" of batch {where[:-1]}" if len(where) > 1 else ""
+        more = f" ({len(hits)} environments had one)" if len(hits) > 1 else ""
+        raise ValueError(f"kage.jax: the actions of step {step} held {value} for environment {where[-1]}{batch}"
+                         f"{more}: {vector.native().action_range_text()}; that step ran with the value masked to "
+                         "its low 3 bits")
+
+    def __repr__(self) -> str:
+        return f"<kage.jax.JaxEnv {self.config!r}, {self.num_envs} envs, spec {self.spec_hash[:12]}>"
+
+    # ---- checks at trace time ----
+
+    def _seed_words(self, seed):
+        n = self.num_envs
+        if isinstance(seed, (bool, np.bool_)):
+            raise TypeError(f"seed={seed!r}: a non-negative int or a uint32 scalar")
+        if isinstance(seed, (int, np.integer)):
+            if int(seed) < 0:
+                raise ValueError(f"seed={seed}: a non-negative integer (numpy's SeedSequence takes no negative seed)")
+            if int(seed) >= 2**32:  # beyond one uint32 word: the same seeds, derived on the host
+                return jnp.asarray(vector.env_seeds(int(seed), n).view(np.uint32).reshape(n, 2))
+            seed = jnp.uint32(seed)
+        if not hasattr(seed, "shape") or not hasattr(seed, "dtype"):
+            raise TypeError(f"seed: a non-negative int or a uint32 scalar, got {type(seed).__name__}")
+        if seed.shape != () or seed.dtype != jnp.uint32:
+            raise TypeError(f"seed: a non-negative int or a uint32 scalar, got {seed.dtype} of shape {seed.shape} "
+                            "(jnp.uint32(s) or x.astype(jnp.uint32); under vmap, one uint32 per batch)")
+        return env_seed_words(seed, n)
+
+    def _check_state(self, state, batched: bool = False) -> None:
+        if not isinstance(state, KageState):
+            raise TypeError(f"state: expected the KageState that this environment's reset or step returned, "
+                            f"got {type(state).__name__}")
+        if state.spec_hash != self.spec_hash:
+            raise ValueError(f"state: it belongs to the config with spec hash {state.spec_hash[:16]}..., but this "
+                             f"environment runs {self.config} (spec hash {self.spec_hash[:16]}...): give each "
+                             "environment the state its own reset returned")
+        for field in _ARRAY_FIELDS:
+            got, want = getattr(state, field), getattr(self._state, field)
+            pairs = [(f"{field}[{k!r}]", got.get(k), w) for k, w in want.items()] if field == "final_info" \
+                else [(field, got, want)]
+            for name, g, w in pairs:
+                shape = getattr(g, "shape", None)
+                if shape is None or (shape[len(shape) - len(w.shape):] if batched else shape) != w.shape:
+                    raise ValueError(f"state.{name}: shape {shape}, expected {w.shape} for {self.num_envs} "
+                                     "environments of this config")
+                if g.dtype != w.dtype:
+                    raise TypeError(f"state.{name}: dtype {g.dtype}, expected {w.dtype}")
+
+    def _check_actions(self, actions):
+        shape, dtype = getattr(actions, "shape", None), getattr(actions, "dtype", None)
+        if shape is None or dtype is None:
+            actions = jnp.asarray(actions)
+            shape, dtype = actions.shape, actions.dtype
+        if tuple(shape) != (self.num_envs,):
+            raise ValueError(f"actions: shape {tuple(shape)}, expected ({self.num_envs},): one action per environment")
+        if dtype != jnp.int32:
+            raise TypeError(f"actions: dtype {dtype}, expected int32 (e.g. jax.random.categorical's output, or "
+                            "actions.astype(jnp.int32))")
+        return jnp.asarray(actions)
+
+    def _with_final(self, info: Dict[str, Any], state: KageState, final_mask) -> Dict[str, Any]:
+        out = dict(info)
+        out.update(zip(_FINAL_KEYS, (state.final_obs, state.final_info, final_mask, final_mask, final_mask)))
+        return out
+
+
+def make_env(config: Union[str, os.PathLike], num_envs: int, asset_root=None) -> JaxEnv:
+    """``num_envs`` environments of ``config`` (a YAML file or a ``kagec compile`` directory) for JAX.
+
+    Raises what ``kage.make_vec`` raises for the same config: ``kage.ConfigError`` with kagec's located
+    diagnostics, ``FileNotFoundError``, ``ValueError`` for bad arguments. ``asset_root`` as make_vec's.
+    """
+    if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs <= 0:
+        raise ValueError(f"num_envs={num_envs!r}: a positive integer")
+    # One CPU environment of make_vec: its errors, its resolved path and the dtypes of its outputs.
+    probe = vector.make_vec(config, 1, device="cpu", threads=1, asset_root=asset_root)
+    try:
+        obs, _ = probe.reset(seed=0)
+        _, reward, terminated, _, info = probe.step(np.zeros(1, np.int32))
+        dtypes = {"obs": obs.dtype, "reward": reward.dtype, "flag": terminated.dtype, "final": info["_final"].dtype,
+                  **{name: info[name].dtype for name in _INFO_NAMES}}
+        path, spec_hash = probe.config, probe.spec_hash
+    finally:
+        probe.close()
+    _ffi.register()
+    sizes = _native.module().register_config(path, os.fspath(asset_root) if asset_root else "")
+    if sizes["spec_hash"] != spec_hash:
+        raise RuntimeError(f"kage.jax: {path} has spec hash {sizes['spec_hash']} here but {spec_hash} in make_vec: "
+                           "kage._kage and kage._kage_jax come from different builds; reinstall")
+    return JaxEnv(path, int(num_envs), sizes, dtypes)
