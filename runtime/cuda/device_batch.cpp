@@ -96,6 +96,66 @@ int32_t visual_state_extent(const VisualParams& p, const AssetView& a) {
   return static_cast<int32_t>(offsetof(VisualState, npc_x));
 }
 
+bool upload_dynamic_params(const CudaModule& module, const LatentParams& lp, const VisualParams& vp,
+                           std::string* error) {
+  // The generic build reads its parameters from __constant__ memory; a specialized build has them folded.
+  struct Upload {
+    const char* name;
+    const void* src;
+    size_t bytes;
+  };
+  for (const Upload& u : {Upload{"kage_dynamic_latent", &lp, sizeof lp}, Upload{"kage_dynamic_visual", &vp, sizeof vp}}) {
+    size_t size = 0;
+    if (const CUdeviceptr p = module.global(u.name, &size); p != 0) {
+      if (size != u.bytes) {
+        *error = std::string("DeviceBatch: ") + u.name + " has another size in the module: rebuild it";
+        return false;
+      }
+      if (!check(cuMemcpyHtoD(p, u.src, u.bytes), "cuMemcpyHtoD(params)", error)) return false;
+    }
+  }
+  return true;
+}
+
+std::optional<DeviceAssets> upload_assets(const AssetView& ha, std::string* error) {
+  // One allocation, pointers rebased.
+  const int32_t frames = frame_count(ha);
+  const size_t bg_bytes = static_cast<size_t>(ha.bg_count) * ha.bg_h * ha.bg_w * 3;
+  const size_t px_bytes = sprite_bytes(ha, frames);
+  const size_t o_px = align256(bg_bytes);
+  const size_t o_frames = o_px + align256(px_bytes);
+  const size_t o_sets = o_frames + align256(frames * sizeof(SpriteFrame));
+  size_t total = o_sets;
+  size_t set_off[3];
+  const SpriteSetTable* tables[3] = {&ha.agent_skins, &ha.npc_types, &ha.sticky_types};
+  for (int i = 0; i < 3; ++i) {
+    set_off[i] = total;
+    total += align256(tables[i]->count * sizeof(SpriteSet));
+  }
+  DeviceAssets d;
+  if (!check(cuMemAlloc(&d.memory, std::max<size_t>(total, 256)), "cuMemAlloc(assets)", error)) return std::nullopt;
+  auto upload = [&](size_t off, const void* src, size_t bytes) {
+    return bytes == 0 || check(cuMemcpyHtoD(d.memory + off, src, bytes), "cuMemcpyHtoD(assets)", error);
+  };
+  bool ok = upload(0, ha.bg, bg_bytes) && upload(o_px, ha.sprite_pixels, px_bytes) &&
+            upload(o_frames, ha.frames, frames * sizeof(SpriteFrame));
+  for (int i = 0; i < 3 && ok; ++i) ok = upload(set_off[i], tables[i]->sets, tables[i]->count * sizeof(SpriteSet));
+  if (!ok) {
+    cuMemFree(d.memory);
+    return std::nullopt;
+  }
+  auto at = [&](size_t off) { return reinterpret_cast<const uint8_t*>(d.memory + off); };
+  AssetView& da = d.view;
+  da = ha;
+  da.bg = bg_bytes ? at(0) : nullptr;
+  da.sprite_pixels = px_bytes ? at(o_px) : nullptr;
+  da.frames = frames ? reinterpret_cast<const SpriteFrame*>(at(o_frames)) : nullptr;
+  SpriteSetTable* dtables[3] = {&da.agent_skins, &da.npc_types, &da.sticky_types};
+  for (int i = 0; i < 3; ++i)
+    dtables[i]->sets = tables[i]->count ? reinterpret_cast<const SpriteSet*>(at(set_off[i])) : nullptr;
+  return d;
+}
+
 std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const LatentParams& lp,
                                                const VisualParams& vp, const AssetView& host_assets, int32_t num_envs,
                                                std::string* error) {
@@ -118,25 +178,7 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
     *fn = module.function(name, error);
     if (!*fn) return std::nullopt;
   }
-  // The generic build reads its parameters from __constant__ memory; a specialized build has them folded.
-  struct Upload {
-    const char* name;
-    const void* src;
-    size_t bytes;
-  };
-  for (const Upload& u : {Upload{"kage_dynamic_latent", &lp, sizeof lp}, Upload{"kage_dynamic_visual", &vp, sizeof vp}}) {
-    const char* name = u.name;
-    const void* src = u.src;
-    const size_t bytes = u.bytes;
-    size_t size = 0;
-    if (const CUdeviceptr p = module.global(name, &size); p != 0) {
-      if (size != bytes) {
-        *error = std::string("DeviceBatch: ") + name + " has another size in the module: rebuild it";
-        return std::nullopt;
-      }
-      if (!check(cuMemcpyHtoD(p, src, bytes), "cuMemcpyHtoD(params)", error)) return std::nullopt;
-    }
-  }
+  if (!upload_dynamic_params(module, lp, vp, error)) return std::nullopt;
   b.render_threads_ = render_threads(vp);
   b.render_smem_ = render_dynamic_smem_bytes(vp);
   CUdevice dev;
@@ -150,39 +192,11 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
              "cuFuncSetAttribute(dynamic shared memory)", error))
     return std::nullopt;
 
-  // Assets: one allocation, pointers rebased.
+  std::optional<DeviceAssets> assets = upload_assets(host_assets, error);
+  if (!assets) return std::nullopt;
+  b.assets_ = assets->memory;
+  b.envs_.assets = assets->view;
   const AssetView& ha = host_assets;
-  const int32_t frames = frame_count(ha);
-  const size_t bg_bytes = static_cast<size_t>(ha.bg_count) * ha.bg_h * ha.bg_w * 3;
-  const size_t px_bytes = sprite_bytes(ha, frames);
-  const size_t o_px = align256(bg_bytes);
-  const size_t o_frames = o_px + align256(px_bytes);
-  const size_t o_sets = o_frames + align256(frames * sizeof(SpriteFrame));
-  size_t total = o_sets;
-  size_t set_off[3];
-  const SpriteSetTable* tables[3] = {&ha.agent_skins, &ha.npc_types, &ha.sticky_types};
-  for (int i = 0; i < 3; ++i) {
-    set_off[i] = total;
-    total += align256(tables[i]->count * sizeof(SpriteSet));
-  }
-  if (!check(cuMemAlloc(&b.assets_, std::max<size_t>(total, 256)), "cuMemAlloc(assets)", error)) return std::nullopt;
-  auto upload = [&](size_t off, const void* src, size_t bytes) {
-    return bytes == 0 || check(cuMemcpyHtoD(b.assets_ + off, src, bytes), "cuMemcpyHtoD(assets)", error);
-  };
-  if (!upload(0, ha.bg, bg_bytes) || !upload(o_px, ha.sprite_pixels, px_bytes) ||
-      !upload(o_frames, ha.frames, frames * sizeof(SpriteFrame)))
-    return std::nullopt;
-  for (int i = 0; i < 3; ++i)
-    if (!upload(set_off[i], tables[i]->sets, tables[i]->count * sizeof(SpriteSet))) return std::nullopt;
-  auto at = [&](size_t off) { return reinterpret_cast<const uint8_t*>(b.assets_ + off); };
-  AssetView& da = b.envs_.assets;
-  da = ha;
-  da.bg = bg_bytes ? at(0) : nullptr;
-  da.sprite_pixels = px_bytes ? at(o_px) : nullptr;
-  da.frames = frames ? reinterpret_cast<const SpriteFrame*>(at(o_frames)) : nullptr;
-  SpriteSetTable* dtables[3] = {&da.agent_skins, &da.npc_types, &da.sticky_types};
-  for (int i = 0; i < 3; ++i)
-    dtables[i]->sets = tables[i]->count ? reinterpret_cast<const SpriteSet*>(at(set_off[i])) : nullptr;
 
   // State and observations.
   const size_t n = static_cast<size_t>(num_envs);

@@ -25,6 +25,20 @@ namespace kage {
 /// arrays of disabled entity kinds are never touched, so the rendering blocks copy only this prefix.
 int32_t visual_state_extent(const VisualParams& vp, const AssetView& assets);
 
+/// A config's assets in device memory: one allocation, and a view whose pointers point into it.
+struct DeviceAssets {
+  CUdeviceptr memory = 0;  ///< freed by the owner (cuMemFree)
+  AssetView view{};
+};
+
+/// Copies host assets into the current context's device memory (synchronous copies); nothing on error.
+std::optional<DeviceAssets> upload_assets(const AssetView& host_assets, std::string* error);
+
+/// Writes the parameters into the generic build's __constant__ memory where `module` has it (a specialized
+/// build has them folded in); false with a message on error.
+[[nodiscard]] bool upload_dynamic_params(const CudaModule& module, const LatentParams& lp, const VisualParams& vp,
+                                         std::string* error);
+
 /// Actions in device memory: element env * stride of an int32 or int64 array.
 struct DeviceActions {
   CUdeviceptr data = 0;
