@@ -17,7 +17,10 @@ def main(argv: Optional[List[str]] = None) -> int:
     status.add_argument("dir", help="a directory written by `python3 -m kage.bench run` or `slurm`")
     report = commands.add_parser("report", help="write the tables and plots of a benchmark directory")
     report.add_argument("dir", help="a directory written by `python3 -m kage.bench run`")
-    report.add_argument("--out", help="where to write (default DIR/report)")
+    report.add_argument("--out", help="where to write (default DIR/report, DIR/report_final with --protocol final)")
+    report.add_argument("--protocol", choices=("max", "final"), default="max",
+                        help="a run's value: its maximum over training (the paper's) or its last evaluation")
+    report.add_argument("--reps", type=int, default=50000, help="bootstrap resamples of the interval estimates")
     if argv[:1] == ["run"]:
         from kage.bench import run
         return run.main(argv[1:])
@@ -36,7 +39,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         status_module.status(args.dir, sys.stdout)
         return 0
     from kage.bench import report as report_module
-    written = report_module.report(args.dir, args.out)
+    written = report_module.report(args.dir, args.out, args.protocol, args.reps)
     print(f"kage.bench report: wrote {written['out_dir']}", file=sys.stderr)
     return 0
 

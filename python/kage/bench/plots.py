@@ -8,6 +8,11 @@
     drop_per_axis.png         the success_once drop per axis (%), the drop of the axis means
     sweep_<sweep>.png         per sweep: eval success_once against the swept value (mean ± SEM over seeds),
                               the train config's value as a dashed line
+    intervals.png             rliable's interval plot: per axis and over all pairs, the IQM of eval success and
+                              the success drop, each a bar over its 95 % interval with a tick at the point
+                              (kage.bench compare: one bar per method)
+    profile_success.png       performance profiles: the fraction of runs whose success exceeds each threshold,
+                              with a 95 % band; eval (and train, dashed) in the report, eval per method in compare
 
 The curves take every run's evaluation rows, finished or not: at each step the mean is over the runs that
 reached it, so an unfinished run stops contributing after its last evaluation; the title then says how many
@@ -19,19 +24,23 @@ matplotlib is imported when a figure is drawn, and draws through its Agg canvas 
 display or backend setting is involved.
 """
 import io
-from typing import List, Optional, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 TRAIN_COLOUR, EVAL_COLOUR = "#1f77b4", "#d62728"
+METHOD_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#7f7f7f")
 BAND_ALPHA = 0.18
 SIZE, DPI = (4.2, 3.0), 200
 
 
-def new_figure():
+def new_figure(size: Tuple[float, float] = SIZE, columns: int = 1):
+    """A figure and its axes: one, or a list of `columns` side by side."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-    figure = Figure(figsize=SIZE)
+    figure = Figure(figsize=size)
     FigureCanvasAgg(figure)
-    return figure, figure.add_subplot()
+    if columns == 1:
+        return figure, figure.add_subplot()
+    return figure, [figure.add_subplot(1, columns, i + 1) for i in range(columns)]
 
 
 def legend(ax) -> None:
@@ -105,6 +114,53 @@ def sweep_response(title: str, names: List[str], evaluated: List[dict], train: d
     ax.set_xlabel("eval config")
     ax.set_ylabel("success rate (success_once)")
     ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    legend(ax)
+    return png_bytes(figure)
+
+
+def interval_estimates(methods: Dict[str, List[dict]]) -> bytes:
+    """Per row of kage.bench.intervals (the axes, then all pairs), a bar over each method's 95 % interval and a
+    black tick at its point: the IQM of eval success on the left, the drop (%) on the right. `methods` maps a
+    name ("" for the report's one method) to its rows, the same rows in the same order for every method."""
+    names = [r["name"] for r in next(iter(methods.values()))]
+    figure, panels = new_figure((8.4, 1.2 + 0.42 * len(names) * max(1, len(methods) / 2)), columns=2)
+    height = 0.8 / len(methods)
+    for panel, key, xlabel in ((panels[0], "eval_iqm", "IQM of eval success"), (panels[1], "drop_pct", "success drop (%)")):
+        for i, (method, rows) in enumerate(methods.items()):
+            colour = METHOD_COLOURS[i % len(METHOD_COLOURS)]
+            for y, row in enumerate(rows):
+                estimate, centre = row[key], y + (i - (len(methods) - 1) / 2) * height
+                if estimate is None or estimate["point"] is None:
+                    continue
+                if estimate["low"] is not None:
+                    panel.barh(centre, estimate["high"] - estimate["low"], left=estimate["low"], height=0.85 * height,
+                               color=colour, alpha=0.75, label=method if method and y == 0 else None)
+                panel.plot([estimate["point"]] * 2, [centre - 0.42 * height, centre + 0.42 * height], color="black",
+                           linewidth=1.5)
+        panel.set_yticks(range(len(names)), names if panel is panels[0] else [""] * len(names))
+        panel.set_ylim(len(names) - 0.5, -0.5)
+        panel.set_xlabel(xlabel)
+        panel.grid(axis="x", alpha=0.3)
+    panels[0].set_xlim(-0.02, 1.02)
+    panels[1].axvline(0, color="black", linewidth=0.8)
+    figure.suptitle("95 % bootstrap intervals (bars) and point estimates (ticks)", fontsize=10)
+    legend(panels[0])
+    return png_bytes(figure)
+
+
+def performance_profiles(taus: Sequence[float], curves: Dict[str, dict], dashed: Sequence[str] = ()) -> bytes:
+    """Per curve ({"point", "low", "high"} per threshold), the fraction of runs whose success exceeds each
+    threshold tau, with its 95 % band; the curves named in `dashed` drawn dashed."""
+    figure, ax = new_figure()
+    for i, (name, curve) in enumerate(curves.items()):
+        colour = {"eval": EVAL_COLOUR, "train": TRAIN_COLOUR}.get(name, METHOD_COLOURS[i % len(METHOD_COLOURS)])
+        ax.plot(taus, curve["point"], color=colour, label=name, linewidth=1.5, linestyle="--" if name in dashed else "-")
+        ax.fill_between(taus, curve["low"], curve["high"], color=colour, alpha=BAND_ALPHA, linewidth=0)
+    ax.set_xlabel("success threshold τ")
+    ax.set_ylabel("fraction of runs with success > τ")
+    ax.set_ylim(0, 1.05)
+    ax.set_title("performance profile of success (95 % bands)", fontsize=10)
     ax.grid(alpha=0.3)
     legend(ax)
     return png_bytes(figure)

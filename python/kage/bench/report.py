@@ -11,9 +11,11 @@ Input, as `python3 -m kage.bench run` writes it:
                                    pairs with one train config, one eval label per pair)
 
 The protocol is the paper's (kage-ppo-baseline.md §5), in three levels:
-1. per run: each value's maximum over the run's evaluation points (summary.json's "max"), the train side
-   (train/<m>), each eval side (eval/<label>/<m>) and each absolute difference (diff/<label>/<m>) maximised
-   independently, so a run's best train and best eval values may come from different checkpoints (§5.1);
+1. per run (`protocol` "max", the default): each value's maximum over the run's evaluation points (summary.json's
+   "max"), the train side (train/<m>), each eval side (eval/<label>/<m>) and each absolute difference
+   (diff/<label>/<m>) maximised independently, so a run's best train and best eval values may come from
+   different checkpoints (§5.1). The maximum of 32 noisy evaluations flatters a run; `protocol` "final" takes
+   instead each value at the run's last evaluation point (the final checkpoint: metrics.jsonl's last row);
 2. per pair: the mean and SEM over seeds, SEM = s / sqrt(n) with s the sample standard deviation
    (divisor n - 1), and SEM = 0 for n = 1 (§5.2);
 3. per axis: the mean and SEM (same formula) of the axis's per-pair means, each pair weighted equally, the
@@ -24,6 +26,10 @@ means of that level, not averaged from the level below. The paper's per-axis dro
 original code does not compute it (§5.4). The drop is undefined (null in JSON, empty in CSV, "n/a" in
 Markdown) where the train mean is 0. `max_abs_diff` is the original's own gap measure: per run, the largest
 |train - eval| at a single evaluation point, then averaged like any other value.
+
+Beside these, interval estimates of success (kage.bench.intervals, after rliable): per axis and over all plain
+pairs, the IQM of eval and train success with 95 % stratified-bootstrap intervals and the drop with a paired
+ratio bootstrap, and the performance profile of eval success.
 
 Only finished runs (with summary.json) enter the tables; unfinished ones are counted and listed. A pair,
 sweep or axis without a finished run appears with n = 0 and empty values. A side's mean is over the values
@@ -37,12 +43,15 @@ CSV and JSON files with every other metric.
 Output, in DIR/report/ (or out_dir), each file replaced atomically:
 
     axes.md, axes.csv        level 3 (if the suite has plain pairs): the headline table
+    intervals.md, .csv       IQM and drop with 95 % intervals per axis and over all pairs (if plain pairs)
     pairs.md, pairs.csv      level 2, plain pairs (if any)
     sweeps.md, sweeps.csv    level 2, per sweep and eval config (if the suite has sweeps)
     runs.csv                 level 1, one row per run, eval config and metric
     report.md                all the Markdown tables, the axes first
     report.json              everything above, the runs found and the protocol
     plots/*.png              see kage.bench.plots
+
+With `protocol` "final" the default directory is DIR/report_final/.
 """
 import json
 import math
@@ -50,15 +59,19 @@ import os
 import re
 import statistics
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Dict, List, NoReturn, Optional, Sequence, Tuple
 
-from kage.bench import plots
+from kage.bench import intervals, plots
 from kage.bench.units import Unit, units_of
-from kage.bench.tables import METRICS, SUCCESS_SHOWN, write_tables
+from kage.bench.tables import METRICS, PROTOCOL_TEXTS, SUCCESS_SHOWN, write_tables
 from kage.util.files import atomic_write, safe
 
 DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # as kage.ppo.train logs
+PROTOCOLS = ("max", "final")
+LEVEL_1 = {"max": "per run, each value's maximum over its evaluation points (summary.json max), every side maximised "
+                  "independently",
+           "final": "per run, each value at its last evaluation point (the final checkpoint)"}
 
 
 def fail(message: str) -> NoReturn:
@@ -73,6 +86,7 @@ class Run:
     path: str
     stats: Optional[dict]  # summary.json's stats; None while the run is unfinished
     evaluations: List[dict]  # the evaluation rows of metrics.jsonl
+    args: dict = field(default_factory=dict)  # run.json's: the trainer's arguments
 
 
 def read_json(path: str, remedy: str):
@@ -129,9 +143,12 @@ def find_runs(bench_dir: str, unit: Unit) -> List[Run]:
 def read_run(seed: int, path: str) -> Run:
     summary = os.path.join(path, "summary.json")
     metrics = os.path.join(path, "metrics.jsonl")
+    run_json = os.path.join(path, "run.json")
     stats = read_summary(summary) if os.path.exists(summary) else None
     evaluations = read_evaluations(metrics) if os.path.exists(metrics) else []
-    return Run(seed, path, stats, evaluations)
+    args = read_json(run_json, "delete the run directory and rerun `python3 -m kage.bench run` to train it again") \
+        if os.path.exists(run_json) else {}
+    return Run(seed, path, stats, evaluations, args.get("args", {}) if isinstance(args, dict) else {})
 
 
 def is_number(value) -> bool:
@@ -202,24 +219,48 @@ def gap_and_drop(train: Optional[float], evaluated: Optional[float]) -> Tuple[Op
     return gap, (100.0 * gap / train if train != 0 else None)
 
 
-def stat_max(stats: dict, key: str, where: str) -> Optional[float]:
-    if key not in stats:
+def flat_row(row: dict) -> Dict[str, Optional[float]]:
+    """An evaluation row under summary.json's keys, train/<m>, eval/<label>/<m> and diff/<label>/<m>, as
+    kage.ppo.rundir.summarize flattens it (that module needs torch, the report does not)."""
+    flat = {f"train/{m}": v for m, v in row["train"].items()}
+    for label, side in row["evals"].items():
+        flat.update({f"eval/{label}/{m}": v for m, v in side.items()})
+    for label, diff in row.get("diffs", {}).items():
+        flat.update({f"diff/{label}/{m}": v for m, v in diff.items()})
+    return {k: (float(v) if is_number(v) else None) for k, v in flat.items()}
+
+
+def run_values(run: Run, protocol: str) -> Optional[Dict[str, Optional[float]]]:
+    """A finished run's value per summary key under `protocol`: "max", summary.json's maxima; "final", its last
+    evaluation row. None for an unfinished run."""
+    if run.stats is None:
+        return None
+    if protocol == "max":
+        return {k: (None if v is None else float(v["max"])) for k, v in run.stats.items()}
+    if not run.evaluations:
+        fail(f"{os.path.join(run.path, 'metrics.jsonl')} has no evaluation row, which --protocol final reads: use "
+             "--protocol max, or delete the run directory and rerun `python3 -m kage.bench run`")
+    return flat_row(run.evaluations[-1])
+
+
+def value_of(values: dict, key: str, where: str) -> Optional[float]:
+    if key not in values:
         fail(f"{where} has no '{key}': the run was not evaluated on this suite's configs (evaluation off, or other "
              "eval labels); delete the run directory and rerun `python3 -m kage.bench run`")
-    return None if stats[key] is None else float(stats[key]["max"])
+    return values[key]
 
 
-def run_maxima(stats: dict, label: str, where: str = "summary.json") -> Dict[str, dict]:
-    """Level 1: per metric, the run's maxima over training of the train side, of the eval side `label` and
-    of their absolute difference, each on its own; and the gap and drop of the two maxima."""
-    values = {}
+def run_scores(values: dict, label: str, where: str = "summary.json") -> Dict[str, dict]:
+    """Level 1: per metric, the run's value (run_values) of the train side, of the eval side `label` and of
+    their absolute difference, each on its own; and the gap and drop of the two."""
+    scores = {}
     for m in METRICS:
-        train = stat_max(stats, f"train/{m}", where)
-        evaluated = stat_max(stats, f"eval/{label}/{m}", where)
+        train = value_of(values, f"train/{m}", where)
+        evaluated = value_of(values, f"eval/{label}/{m}", where)
         gap, drop = gap_and_drop(train, evaluated)
-        diff = stat_max(stats, f"diff/{label}/{m}", where) if m in DIFF_METRICS else None
-        values[m] = {"train": train, "eval": evaluated, "gap": gap, "drop_pct": drop, "max_abs_diff": diff}
-    return values
+        diff = value_of(values, f"diff/{label}/{m}", where) if m in DIFF_METRICS else None
+        scores[m] = {"train": train, "eval": evaluated, "gap": gap, "drop_pct": drop, "max_abs_diff": diff}
+    return scores
 
 
 def combine(samples: List[Dict[str, dict]]) -> Dict[str, dict]:
@@ -236,7 +277,7 @@ def combine(samples: List[Dict[str, dict]]) -> Dict[str, dict]:
 
 
 def over_seeds(run_values: List[Dict[str, dict]]) -> Dict[str, dict]:
-    """Level 2: a pair's runs' maxima (run_maxima), over seeds."""
+    """Level 2: a pair's runs' values (run_scores), over seeds."""
     return combine(run_values)
 
 
@@ -255,18 +296,20 @@ def sweep_order(names: List[str]) -> List[str]:
         return list(names)
 
 
-def aggregate(units: List[Unit], runs: Dict[str, List[Run]]) -> dict:
+def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "max") -> dict:
     """The three levels: {"runs": level 1, "pairs": level 2 (plain pairs), "axes": level 3, "sweeps": level 2
-    per sweep}."""
+    per sweep}; `protocol` chooses a run's value (run_values)."""
     level1, pairs, sweeps = [], [], []
     for unit in units:
-        finished = [r for r in runs[unit.name] if r.stats is not None]
+        scored = [(r, v) for r in runs[unit.name] for v in [run_values(r, protocol)] if v is not None]
+        finished = [r for r, _ in scored]
         results = {}
         for pair in unit.pairs:
             label = unit.label(pair)
             per_run = []
-            for run in finished:
-                values = run_maxima(run.stats, label, os.path.join(run.path, "summary.json"))
+            for run, run_value in scored:
+                where = os.path.join(run.path, "summary.json" if protocol == "max" else "metrics.jsonl")
+                values = run_scores(run_value, label, where)
                 level1.append({"pair": pair["pair"], "unit": unit.name, "seed": run.seed, "label": label,
                                "path": run.path, "metrics": values})
                 per_run.append(values)
@@ -326,7 +369,8 @@ def curve(evaluations: List[List[dict]], label: Optional[str], metric: str) -> L
     return [(step, mean_sem(values)) for step, values in sorted(by_step.items())]
 
 
-def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], levels: dict) -> List[str]:
+def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], levels: dict,
+                estimates: Optional[dict]) -> List[str]:
     """The PNG files under plots/ (see kage.bench.plots); returns their names relative to out_dir."""
     figures: Dict[str, bytes] = {}
     for unit in units:
@@ -344,6 +388,11 @@ def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], lev
     if levels["axes"]:
         drops = [a["metrics"][SUCCESS_SHOWN]["drop_pct"] for a in levels["axes"]]
         figures["plots/drop_per_axis.png"] = plots.drop_per_axis([a["axis"] for a in levels["axes"]], drops)
+    if estimates and estimates["profile"]:
+        figures["plots/intervals.png"] = plots.interval_estimates({"": estimates["rows"]})
+        profile = estimates["profile"]
+        figures["plots/profile_success.png"] = plots.performance_profiles(
+            profile["taus"], {"eval": profile["eval"], "train": profile["train"]}, dashed={"train"})
     for s in levels["sweeps"]:
         figures[f"plots/sweep_{safe(s['sweep'])}.png"] = plots.sweep_response(
             f"{s['sweep']} ({s['axis']})", [e["sweep_eval"] for e in s["evals"]],
@@ -356,32 +405,38 @@ def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], lev
 
 # ---- the command ----
 
-def report(bench_dir: str, out_dir: Optional[str] = None) -> dict:
+def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
+           reps: int = intervals.REPS) -> dict:
     """Reads the benchmark directory `bench_dir`, writes the tables, plots and report.json into `out_dir`
-    (default bench_dir/report) and returns report.json's content."""
+    (default bench_dir/report, or report_final under `protocol` "final") and returns report.json's content.
+    `reps`: bootstrap resamples of the interval estimates."""
+    if protocol not in PROTOCOLS:
+        fail(f"unknown protocol '{protocol}': choose {' or '.join(PROTOCOLS)}")
     suite = load_suite(bench_dir)
     bench = read_bench(bench_dir)
-    out_dir = out_dir or os.path.join(bench_dir, "report")
+    out_dir = out_dir or os.path.join(bench_dir, "report" if protocol == "max" else "report_final")
     selected = bench.get("units")  # what `run --pairs` chose, when it chose
     units = [u for u in units_of(suite, bench.get("shared")) if selected is None or u.name in selected]
     runs = {unit.name: find_runs(bench_dir, unit) for unit in units}
-    levels = aggregate(units, runs)
+    levels = aggregate(units, runs, protocol)
     status = run_status(units, runs, [s for s in bench.get("seeds", []) if isinstance(s, int)])
     result = {
         "kage_bench_report": 1, "suite": suite.get("suite", "suite"), "manifest": suite.get("manifest"),
         "bench_dir": bench_dir, "out_dir": out_dir, "seeds": bench.get("seeds"),
         "protocol": {
-            "level_1_runs": "per run, each value's maximum over its evaluation points (summary.json max), every "
-                            "side maximised independently",
+            "score": protocol,
+            "level_1_runs": LEVEL_1[protocol],
             "level_2_pairs": "per pair, mean and SEM over seeds (SEM = sample sd / sqrt(n), 0 for n = 1)",
             "level_3_axes": "per axis, mean and SEM of the plain pairs' means, each pair weighted equally",
             "gap": "train_mean - eval_mean, on the means of the level",
             "drop_pct": "100 * (train_mean - eval_mean) / train_mean, on the means of the level; null where "
                         "train_mean is 0",
-            "max_abs_diff": "per run the largest |train - eval| at one evaluation point, aggregated like a value",
+            "max_abs_diff": "per run the largest |train - eval| at one evaluation point, aggregated like a value"
+                            if protocol == "max" else "per run |train - eval| at its last evaluation point",
         },
         "metrics": list(METRICS), "markdown_success_column": SUCCESS_SHOWN,
         "runs_found": status, "levels": levels,
+        "intervals": intervals.interval_report(levels["runs"], levels["pairs"], reps) if levels["pairs"] else None,
     }
     try:
         write_report(out_dir, result, units, runs)
@@ -393,10 +448,11 @@ def report(bench_dir: str, out_dir: Optional[str] = None) -> dict:
 def write_report(out_dir: str, result: dict, units: List[Unit], runs: Dict[str, List[Run]]) -> None:
     """The tables, the plots, then report.json (`result`, completed with the files written)."""
     os.makedirs(out_dir, exist_ok=True)
-    files = write_tables(out_dir, result["suite"], result["levels"], result["runs_found"])
+    files = write_tables(out_dir, result["suite"], result["levels"], result["runs_found"],
+                         PROTOCOL_TEXTS[result["protocol"]["score"]], result["intervals"])
     result["plots_note"] = None
     try:
-        files += write_plots(out_dir, units, runs, result["levels"])
+        files += write_plots(out_dir, units, runs, result["levels"], result["intervals"])
     except ImportError as e:  # the tables do not need matplotlib
         result["plots_note"] = f"no plots: {e}; install matplotlib (pip install matplotlib) and rerun the report"
         print(f"kage.bench report: {result['plots_note']}", file=sys.stderr)

@@ -4,6 +4,7 @@ digits (at most 2 decimals); "-" where a value is missing, "n/a" for an undefine
 import os
 from typing import List, Optional, Sequence
 
+from kage.bench.interval_tables import intervals_csv, md_intervals
 from kage.util.files import atomic_write
 from kage.util.tables import SUCCESS_NOTE, SUCCESS_SHOWN, csv_text, decimals, fmt_value, md_table
 
@@ -120,6 +121,12 @@ PROTOCOL_TEXT = (
     "mean ± SEM over seeds; per axis, the mean ± SEM of the pairs' means, each pair weighted equally. gap = train "
     "- eval and drop = 100 (train - eval) / train, both on the means of the row; n/a where train is 0. "
     "\"max abs diff\" is the mean ± SEM of each run's largest |train - eval| at one evaluation point.")
+FINAL_TEXT = (
+    "Per run, each value at its last evaluation point (the final checkpoint); per pair, the mean ± SEM over seeds; "
+    "per axis, the mean ± SEM of the pairs' means, each pair weighted equally. gap = train - eval and drop = 100 "
+    "(train - eval) / train, both on the means of the row; n/a where train is 0. \"max abs diff\" is the mean ± "
+    "SEM of each run's |train - eval| at its last evaluation point.")
+PROTOCOL_TEXTS = {"max": PROTOCOL_TEXT, "final": FINAL_TEXT}  # by kage.bench report --protocol
 
 
 def status_text(status: dict) -> str:
@@ -140,9 +147,11 @@ def md_document(title: str, status: dict, body: str, protocol: str = PROTOCOL_TE
 
 # ---- writing ----
 
-def write_tables(out_dir: str, suite_name: str, levels: dict, status: dict, protocol: str = PROTOCOL_TEXT) -> List[str]:
+def write_tables(out_dir: str, suite_name: str, levels: dict, status: dict, protocol: str = PROTOCOL_TEXT,
+                 estimates: Optional[dict] = None) -> List[str]:
     """The CSV and Markdown files; returns their names. `protocol` is the paragraph that says what a value is
-    (kage.ppo.evaluate's differs: one checkpoint instead of maxima over training)."""
+    (kage.ppo.evaluate's differs: one checkpoint instead of maxima over training); `estimates`, the interval
+    estimates of kage.bench.intervals, where there are any."""
     files = {"runs.csv": runs_csv(levels["runs"])}
     combined = []
     if levels["pairs"]:
@@ -150,7 +159,13 @@ def write_tables(out_dir: str, suite_name: str, levels: dict, status: dict, prot
         files["pairs.csv"] = pairs_csv(levels["pairs"])
         files["axes.md"] = md_document(f"{suite_name}: per axis", status, md_axes(levels["axes"], 2), protocol)
         files["pairs.md"] = md_document(f"{suite_name}: per pair", status, md_pairs(levels["pairs"], 2), protocol)
-        combined += [f"## Per axis\n\n{md_axes(levels['axes'], 3)}", f"## Per pair\n\n{md_pairs(levels['pairs'], 3)}"]
+        combined.append(f"## Per axis\n\n{md_axes(levels['axes'], 3)}")
+        if estimates:
+            files["intervals.csv"] = intervals_csv(estimates["rows"])
+            files["intervals.md"] = md_document(f"{suite_name}: interval estimates", status,
+                                                md_intervals(estimates, 2), protocol)
+            combined.append(md_intervals(estimates, 2))
+        combined.append(f"## Per pair\n\n{md_pairs(levels['pairs'], 3)}")
     if levels["sweeps"]:
         files["sweeps.csv"] = sweeps_csv(levels["sweeps"])
         files["sweeps.md"] = md_document(f"{suite_name}: sweeps", status, md_sweeps(levels["sweeps"], 2), protocol)
