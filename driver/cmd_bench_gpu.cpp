@@ -1,4 +1,4 @@
-// kagec bench --gpu (cmd_bench_gpu.h): configs compiled by NVRTC, timed by verify/bench/gpu_measure.h.
+// kagec bench --gpu (cmd_bench_gpu.h): configs compiled by NVRTC, timed by verify/throughput/gpu_measure.h.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -20,7 +20,7 @@
 #include "driver/cmd_bench_gpu.h"
 #include "compiler/lower/lower.h"
 #include "runtime/io/asset_pack.h"
-#include "verify/bench/gpu_measure.h"
+#include "verify/throughput/gpu_measure.h"
 
 namespace kage {
 
@@ -177,20 +177,20 @@ int bench_gpu(const GpuBenchOptions& o, CommandIo& io) {
   // One config at a time on the device (its module and assets are freed before the next), each row
   // printed and flushed as soon as it is measured; any failure ends the run with a message and exit 1.
   try {
-    const double roof = bench::measure_roofline();
+    const double roof = throughput::measure_roofline();
     io.out << "kagec bench --gpu on " << name << ": roofline (device-to-device copy, read + write) " << fixed(roof, 1)
            << " GB/s\n\n| config | envs | steps/s with obs | obs GB/s | % of roofline | steps/s no render |\n"
               "|---|---|---|---|---|---|\n"
            << std::flush;
     for (const Job& j : jobs) {
       std::optional<CudaModule> module = CudaModule::load_image(j.cubin->data(), &error);
-      if (!module) throw bench::MeasureError(j.label + ": " + error);
+      if (!module) throw throughput::MeasureError(j.label + ": " + error);
       AssetPackResult assets = load_asset_pack(j.config.assets);
-      if (!assets.ok()) throw bench::MeasureError(j.label + ": " + assets.error);
-      const bench::MeasureTarget target{&*module, j.config.latent, j.config.visual, assets.pack->view()};
+      if (!assets.ok()) throw throughput::MeasureError(j.label + ": " + assets.error);
+      const throughput::MeasureTarget target{&*module, j.config.latent, j.config.visual, assets.pack->view()};
       const double frame_bytes = 3.0 * j.config.visual.H * j.config.visual.W;
       for (int k = o.min_log2; k <= o.max_log2; ++k) {
-        const bench::Timing t = bench::time_config(target, 1 << k, !o.no_render, true);
+        const throughput::Timing t = throughput::time_config(target, 1 << k, !o.no_render, true);
         const double gbs = t.render_steps_per_s * frame_bytes / 1e9;
         io.out << "| " << j.label << " | 2^" << k << " | ";
         if (o.no_render) {

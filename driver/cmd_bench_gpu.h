@@ -1,5 +1,5 @@
 // kagec bench --gpu: compiles configs in-process (NVRTC, through the kernel cache) and measures them
-// with the measurements of kage_gpu_bench (verify/bench/gpu_measure.h). Built only with the CUDA toolkit.
+// with the measurements of kage_gpu_throughput (verify/throughput/gpu_measure.h). Built only with the CUDA toolkit.
 #pragma once
 
 #include <string>

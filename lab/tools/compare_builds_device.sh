@@ -4,7 +4,7 @@
 #     hardest), with kagec built from an earlier tree in .before and from the working tree, the two builds
 #     alternating back to back ROUNDS times (default 3, after one warm-up round that fills the kernel cache);
 #  2. GPU = CPU on every shipped config with the working tree's build: `kagec compile --no-gpu --no-host`,
-#     then `kage_gpu_bench --check-only` (the generic kernels against the CPU batch, 32 environments).
+#     then `kage_gpu_throughput --check-only` (the generic kernels against the CPU batch, 32 environments).
 # STEPS (default "bench check") picks the parts; a warm machine keeps both builds, so the two parts can be
 # two calls. Prepare .before here (listed in .git/info/exclude): git archive COMMIT | tar -x -C .before
 # Carry [".deps", ".before"]:
@@ -16,7 +16,7 @@ ROUNDS=${ROUNDS:-3}
 STEPS=${STEPS:-bench check}
 tools=$PWD/lab/tools  # the .before tree may predate them
 source "$tools/device_build.sh"
-ninja -C "$BUILD" kage_gpu_bench >>"$OUT/build.log" 2>&1 || { tail -40 "$OUT/build.log"; exit 1; }
+ninja -C "$BUILD" kage_gpu_throughput >>"$OUT/build.log" 2>&1 || { tail -40 "$OUT/build.log"; exit 1; }
 after=$PWD/$BUILD/kagec
 
 if [[ $STEPS == *bench* ]]; then
@@ -54,8 +54,8 @@ for config in $(find configs -name '*.yaml' | sort); do
     echo "not compiled: $config (see compile.err)"
 done
 fatbin=$(find "$BUILD" -name dynamic.fatbin | head -1)
-gpu_bench=$(find "$BUILD" -name kage_gpu_bench -type f | head -1)
-"$gpu_bench" "$fatbin" --compiled /tmp/kage-all/* --nvrtc-root "$PWD" --check-only --check-envs 32 \
+gpu_throughput=$(find "$BUILD" -name kage_gpu_throughput -type f | head -1)
+"$gpu_throughput" "$fatbin" --compiled /tmp/kage-all/* --nvrtc-root "$PWD" --check-only --check-envs 32 \
   >"$OUT/check.log" 2>&1
-echo "kage_gpu_bench --check-only: exit $?, $(ls /tmp/kage-all | wc -l) compiled configs"
+echo "kage_gpu_throughput --check-only: exit $?, $(ls /tmp/kage-all | wc -l) compiled configs"
 grep -c PASS "$OUT/check.log"; grep -v PASS "$OUT/check.log" | tail -15

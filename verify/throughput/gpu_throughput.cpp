@@ -1,10 +1,10 @@
-// kage_gpu_bench: correctness (GPU vs CPU batch), load times and throughput of the CUDA runtime
+// kage_gpu_throughput: correctness (GPU vs CPU batch), load times and throughput of the CUDA runtime
 // for configs compiled by `kagec compile`, against a device-to-device copy roofline measured in the
 // same run, and the device's FP32 rate (fp32_peak.fatbin beside GENERIC_FATBIN).
 //
-// Usage: kage_gpu_bench GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] [--check-envs N]
-//                       [--nvrtc-root DIR] [--breakdown] [--skip-checks] [--check-only]
-// GENERIC_FATBIN is the bench build's dynamic.fatbin. Each DIR is a `kagec compile` output directory
+// Usage: kage_gpu_throughput GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] [--check-envs N]
+//                            [--nvrtc-root DIR] [--breakdown] [--skip-checks] [--check-only]
+// GENERIC_FATBIN is this build's dynamic.fatbin. Each DIR is a `kagec compile` output directory
 // (its manifest, kernels.fatbin, the generated source, params.bin, assets.bin, read and verified
 // through compiler/codegen/compiled_dir.h), named after its last path component;
 // --breakdown needs one named "hardest". With --nvrtc-root (the directory holding runtime/), the
@@ -24,14 +24,14 @@
 #include "compiler/codegen/compiled_dir.h"
 #include "runtime/cuda/device_batch.h"
 #include "runtime/cuda/module_loader.h"
-#include "verify/bench/bench_checks.h"
-#include "verify/bench/gpu_measure.h"
+#include "verify/throughput/gpu_checks.h"
+#include "verify/throughput/gpu_measure.h"
 
-namespace kage::bench {
+namespace kage::throughput {
 namespace {
 
 [[noreturn]] void die(const std::string& msg) {
-  std::fprintf(stderr, "kage_gpu_bench: %s\n", msg.c_str());
+  std::fprintf(stderr, "kage_gpu_throughput: %s\n", msg.c_str());
   std::exit(1);
 }
 
@@ -186,14 +186,14 @@ int check_only(const CudaModule& dynamic, const std::vector<BenchDir>& dirs, int
 }
 
 }  // namespace
-}  // namespace kage::bench
+}  // namespace kage::throughput
 
 namespace {
 
 int run(int argc, char** argv) {
   using namespace kage;
-  using namespace kage::bench;
-  if (argc < 2) die("usage: kage_gpu_bench GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] "
+  using namespace kage::throughput;
+  if (argc < 2) die("usage: kage_gpu_throughput GENERIC_FATBIN --compiled DIR... [--min-log2 K] [--max-log2 K] "
                     "[--check-envs N] [--nvrtc-root DIR] [--breakdown] [--skip-checks] [--check-only]");
   int32_t min_log2 = 12, max_log2 = 20, check_envs = 64;
   std::string nvrtc_root;
@@ -230,7 +230,7 @@ int run(int argc, char** argv) {
   char name[256];
   cu_or_die(cuCtxGetDevice(&dev), "cuCtxGetDevice");
   cu_or_die(cuDeviceGetName(name, sizeof name, dev), "cuDeviceGetName");
-  std::printf("# kage_gpu_bench on %s\n\n", name);
+  std::printf("# kage_gpu_throughput on %s\n\n", name);
   if (only_checks) return check_only(load(argv[1]), compiled, check_envs);
 
   // Load to first step: the fatbin through the driver, then the generated source through NVRTC with
@@ -281,7 +281,7 @@ int run(int argc, char** argv) {
   std::fflush(stdout);
 
   const double roof = measure_roofline();
-  // The FP32 kernel sits beside the generic kernels (verify/bench/CMakeLists.txt).
+  // The FP32 kernel sits beside the generic kernels (verify/throughput/CMakeLists.txt).
   const CudaModule fp32 = load((std::filesystem::path(argv[1]).parent_path() / "fp32_peak.fatbin").string());
   const double fp32_gflops = measure_fp32_rate(fp32);
   std::printf("\n## Roofline\n\ndevice-to-device copy: %.1f GB/s (read + write) = %.1f M frames/s of 128x128x3\n"
@@ -323,7 +323,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);
-  } catch (const kage::bench::MeasureError& e) {
-    kage::bench::die(e.what());
+  } catch (const kage::throughput::MeasureError& e) {
+    kage::throughput::die(e.what());
   }
 }

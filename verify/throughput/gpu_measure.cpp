@@ -1,4 +1,4 @@
-#include "verify/bench/gpu_measure.h"
+#include "verify/throughput/gpu_measure.h"
 
 #include <algorithm>
 #include <optional>
@@ -7,7 +7,7 @@
 
 #include "runtime/cuda/device_batch.h"
 
-namespace kage::bench {
+namespace kage::throughput {
 namespace {
 
 constexpr int32_t kRepeats = 5;
@@ -119,4 +119,4 @@ Timing time_config(const MeasureTarget& c, int32_t n, bool render, bool state_to
   return out;
 }
 
-}  // namespace kage::bench
+}  // namespace kage::throughput

@@ -1,4 +1,4 @@
-// The throughput measurements shared by kage_gpu_bench and `kagec bench --gpu`: a device-to-device
+// The throughput measurements shared by kage_gpu_throughput and `kagec bench --gpu`: a device-to-device
 // copy roofline and the step rates of one batch (step + render, state only), so both
 // report numbers taken the same way.
 #pragma once
@@ -12,7 +12,7 @@
 #include "runtime/visual/asset_view.h"
 #include "runtime/visual/visual_params.h"
 
-namespace kage::bench {
+namespace kage::throughput {
 
 /// A CUDA call or a batch operation failed while measuring; what() says which.
 class MeasureError : public std::runtime_error {
@@ -27,7 +27,7 @@ double median_ms(const std::function<void()>& run_once);
 double measure_roofline();
 
 /// The FP32 rate in GFLOP/s (fused multiply-adds counted as 2), from kage_fp32_peak of `module`
-/// (verify/bench/modules/fp32_peak.cu) on a grid that fills the device.
+/// (verify/throughput/modules/fp32_peak.cu) on a grid that fills the device.
 double measure_fp32_rate(const CudaModule& module);
 
 /// What one batch of one config is run with.
@@ -49,4 +49,4 @@ struct Timing {
 /// when `state_too`.
 Timing time_config(const MeasureTarget& t, int32_t n, bool render, bool state_too);
 
-}  // namespace kage::bench
+}  // namespace kage::throughput

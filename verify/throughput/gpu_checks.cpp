@@ -1,5 +1,5 @@
-// GPU vs CPU batch checks (see bench_checks.h).
-#include "verify/bench/bench_checks.h"
+// GPU vs CPU batch checks (see gpu_checks.h).
+#include "verify/throughput/gpu_checks.h"
 
 #include <cstring>
 #include <set>
@@ -10,7 +10,7 @@
 #include "runtime/cpu/host_batch.h"
 #include "runtime/visual/image_diff.h"
 
-namespace kage::bench {
+namespace kage::throughput {
 namespace {
 
 constexpr uint64_t kActionSeed = 7;
@@ -125,4 +125,4 @@ CheckResult check_against_cpu(const CudaModule& module, const LatentParams& lp, 
   return res;
 }
 
-}  // namespace kage::bench
+}  // namespace kage::throughput

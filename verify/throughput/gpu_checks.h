@@ -10,7 +10,7 @@
 #include "runtime/visual/asset_view.h"
 #include "runtime/visual/visual_params.h"
 
-namespace kage::bench {
+namespace kage::throughput {
 
 /// What a check found.
 struct CheckResult {
@@ -28,4 +28,4 @@ struct CheckResult {
 CheckResult check_against_cpu(const CudaModule& module, const LatentParams& lp, const VisualParams& vp,
                               const AssetView& assets, int32_t envs, int32_t steps, int32_t max_code_diff);
 
-}  // namespace kage::bench
+}  // namespace kage::throughput
