@@ -208,8 +208,12 @@ class GpuEnv final : public Env {
   GpuEnv(CUcontext ctx, CudaModule m, DeviceBatch b, AssetPack pack, int32_t H, int32_t W, std::string hash)
       : ctx_(ctx), module_(std::move(m)), pack_(std::move(pack)), batch_(std::move(b)), H_(H), W_(W),
         hash_(std::move(hash)) {}
-  // The members free device memory: in this batch's context, whichever thread drops the last reference.
-  ~GpuEnv() override { cuCtxSetCurrent(ctx_); }
+  // The members free device memory: in this batch's context, whichever thread drops the last reference,
+  // once the device has run all queued work (this batch's launches, and a consumer's kernels on its own
+  // stream still reading an output it viewed): cuMemFree alone does not promise to wait.
+  ~GpuEnv() override {
+    if (cuCtxSetCurrent(ctx_) == CUDA_SUCCESS) cuCtxSynchronize();
+  }
   bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* e) override {
     last_error_kind_ = ErrorKind::kOther;
     return bind(e) && no_pending_error(e) && batch_.reset(seeds, mask, e) && succeeded();

@@ -12,7 +12,9 @@
 
 #include <iterator>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "api/python/cuda_streams.h"
@@ -131,88 +133,47 @@ class DeviceArray {
 };
 
 /// A batch as Python sees it: kage::Env plus the export of its outputs.
+///
+/// Threads: every call runs with the GIL released and the batch's lock held, so calls from several threads
+/// run one at a time, each one whole, and close() waits for a call in progress; calls after close() raise.
+/// The lock is taken only with the GIL released and the GIL is taken back only after the lock is let go,
+/// so a thread waiting for one never holds the other.
 class PyEnv {
  public:
-  explicit PyEnv(std::shared_ptr<kage::Env> env) : env_(std::move(env)) {}
+  explicit PyEnv(std::shared_ptr<kage::Env> env) : env_(std::move(env)), mutex_(std::make_shared<std::mutex>()) {}
 
   /// The output `name` ("obs", "reward", "terminated", "truncated", "final_mask", "final_obs", or
   /// "info/<field>", "final_info/<field>") as a numpy array (CPU) or a DeviceArray (GPU).
   py::object output(const std::string& name) const {
-    const Located l = locate(name);
-    return export_array(l.data, l.shape, l.dtype);
+    std::shared_ptr<kage::Env> owner;
+    const Located l = locked([&](kage::Env& e) {
+      owner = env_;
+      return locate(e, name);
+    });
+    return export_array(owner, l.data, l.shape, l.dtype);
   }
 
   /// The runtime's own pointer to output `name` (host or device address), for checks of zero copy.
-  uintptr_t data_ptr(const std::string& name) const { return reinterpret_cast<uintptr_t>(locate(name).data); }
-
- private:
-  struct Located {
-    const void* data;
-    std::vector<int64_t> shape;
-    kage::DType dtype;
-  };
-
-  Located locate(const std::string& name) const {
-    const int64_t n = env().num_envs();
-    Located l{nullptr, {n}, kage::DType::kUInt8};
-    if (name == "obs" || name == "final_obs") {
-      l.shape = {n, env().height(), env().width(), 3};
-      l.data = name == "obs" ? env().obs() : env().final_obs();
-    } else if (name == "reward") {
-      l.data = env().reward();
-      l.dtype = kage::DType::kFloat32;
-    } else if (name == "terminated") {
-      l.data = env().terminated();
-    } else if (name == "truncated") {
-      l.data = env().truncated();
-    } else if (name == "final_mask") {
-      l.data = env().final_mask();
-    } else {
-      const bool final = name.rfind("final_info/", 0) == 0;
-      const std::string field = name.substr(name.find('/') + 1);
-      int32_t count = 0;
-      const kage::InfoFieldDesc* fields = kage::info_fields(&count);
-      for (int32_t i = 0; i < count && !l.data; ++i) {
-        if (field != fields[i].name) continue;
-        l.data = final ? env().final_info(fields[i].field) : env().info(fields[i].field);
-        l.dtype = fields[i].dtype;
-      }
-      if (!l.data) raise_value_error("no output named '" + name + "'");
-    }
-    return l;
+  uintptr_t data_ptr(const std::string& name) const {
+    return locked([&](kage::Env& e) { return reinterpret_cast<uintptr_t>(locate(e, name).data); });
   }
-
-  py::object export_array(const void* data, const std::vector<int64_t>& shape, kage::DType dtype) const {
-    if (env().backend() == kage::Backend::kGpu) return py::cast(DeviceArray(env_, data, shape, dtype));
-    // Host memory: a numpy view whose base keeps the batch alive.
-    auto* keep = new std::shared_ptr<kage::Env>(env_);
-    py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<kage::Env>*>(p); });
-    std::vector<py::ssize_t> strides(shape.size());
-    py::ssize_t stride = static_cast<py::ssize_t>(facts(dtype).bytes);
-    for (size_t i = shape.size(); i-- > 0;) {
-      strides[i] = stride;
-      stride *= shape[i];
-    }
-    return py::array(numpy_dtype(dtype), std::vector<py::ssize_t>(shape.begin(), shape.end()), strides, data, base);
-  }
-
- public:
 
   void reset(py::array_t<uint64_t, py::array::c_style | py::array::forcecast> seeds, const py::object& mask) {
-    check_length(seeds.size(), "seeds");
+    const int32_t n = num_envs();
+    check_length(seeds.size(), n, "seeds");
     std::vector<uint8_t> m;
     if (!mask.is_none()) {
       auto a = mask.cast<py::array_t<uint8_t, py::array::c_style | py::array::forcecast>>();
-      check_length(a.size(), "mask");
+      check_length(a.size(), n, "mask");
       m.assign(a.data(), a.data() + a.size());
     }
-    std::string error;
-    bool ok;
-    {
-      py::gil_scoped_release release;
-      ok = env().reset(seeds.data(), m.empty() ? nullptr : m.data(), &error);
-    }
-    if (!ok) raise_step_error(error);
+    const uint64_t* s = seeds.data();
+    raise_if_failed(locked([&](kage::Env& e) {
+      Outcome o;
+      o.ok = e.reset(s, m.empty() ? nullptr : m.data(), &o.error);
+      o.kind = e.last_error_kind();
+      return o;
+    }));
   }
 
   /// Host actions: int32 or int64, C-contiguous, num_envs values (checked by the Python side).
@@ -220,25 +181,27 @@ class PyEnv {
     const auto& dt = actions.dtype();
     if ((dt.kind() != 'i') || (dt.itemsize() != 4 && dt.itemsize() != 8) || actions.ndim() != 1)
       raise_value_error("internal: step_host wants a 1-D int32 or int64 array");
-    check_length(actions.size(), "actions");
-    const kage::Actions a{actions.data(), kage::Memory::kHost,
-                          dt.itemsize() == 8 ? kage::DType::kInt64 : kage::DType::kInt32,
-                          actions.strides(0) / dt.itemsize()};
-    run_step(a);
+    check_length(actions.size(), num_envs(), "actions");
+    run_step(kage::Actions{actions.data(), kage::Memory::kHost,
+                           dt.itemsize() == 8 ? kage::DType::kInt64 : kage::DType::kInt32,
+                           actions.strides(0) / dt.itemsize()});
   }
 
   /// Device actions at `ptr` (int32 or int64, `stride` elements apart), produced on `producer_stream`
   /// (a __cuda_array_interface__ stream number; -1: no ordering needed).
   void step_device(uintptr_t ptr, bool is_int64, int64_t stride, int64_t producer_stream) {
-    if (env().backend() != kage::Backend::kGpu)
+    if (device() != "cuda")
       raise_value_error("actions are in GPU memory but the environment runs on the CPU: pass host actions "
                         "(e.g. actions.cpu()) or make the environment with device='cuda'");
-    std::string error;
-    if (producer_stream != -1 &&
-        !kage::python::order_after(kage::python::protocol_stream(producer_stream), env().stream(), &error))
-      throw std::runtime_error(error);
-    run_step(kage::Actions{reinterpret_cast<const void*>(ptr), kage::Memory::kDevice,
-                           is_int64 ? kage::DType::kInt64 : kage::DType::kInt32, stride});
+    const kage::Actions a{reinterpret_cast<const void*>(ptr), kage::Memory::kDevice,
+                          is_int64 ? kage::DType::kInt64 : kage::DType::kInt32, stride};
+    raise_if_failed(locked([&](kage::Env& e) {
+      Outcome o;
+      if (producer_stream != -1 &&
+          !kage::python::order_after(kage::python::protocol_stream(producer_stream), e.stream(), &o.error))
+        throw std::runtime_error(o.error);
+      return step_locked(e, a);
+    }));
   }
 
   /// Device actions from a DLPack capsule (already ordered for this batch's stream by the producer's
@@ -247,13 +210,14 @@ class PyEnv {
     auto* t = static_cast<DLManagedTensor*>(PyCapsule_GetPointer(capsule.ptr(), "dltensor"));
     if (!t) throw py::error_already_set();
     const DLTensor& d = t->dl_tensor;
+    const int32_t n = num_envs();
     std::string problem;
     if (d.device.device_type != kDLCUDA)
       problem = "a DLPack array on device type " + std::to_string(d.device.device_type);
     else if (d.device.device_id != 0)
       problem = "actions on cuda:" + std::to_string(d.device.device_id) + ", the environment runs on cuda:0";
-    else if (d.ndim != 1 || d.shape[0] != env().num_envs())
-      problem = "actions of shape " + shape_text(d) + ", expected (" + std::to_string(env().num_envs()) + ",)";
+    else if (d.ndim != 1 || d.shape[0] != n)
+      problem = "actions of shape " + shape_text(d) + ", expected (" + std::to_string(n) + ",)";
     else if (d.dtype.lanes != 1 || d.dtype.code != kDLInt || (d.dtype.bits != 32 && d.dtype.bits != 64))
       problem = "actions of DLPack type (code " + std::to_string(d.dtype.code) + ", " + std::to_string(d.dtype.bits) +
                 " bits), expected int32 or int64";
@@ -276,53 +240,149 @@ class PyEnv {
 
   py::bytes save_state() const {
     std::vector<uint8_t> out;
-    std::string error;
-    bool ok;
-    {
-      py::gil_scoped_release release;
-      ok = env().save_state(&out, &error);
-    }
-    if (!ok) throw std::runtime_error(error);
+    locked([&](kage::Env& e) {
+      std::string error;
+      if (!e.save_state(&out, &error)) throw std::runtime_error(error);
+      return 0;
+    });
     return py::bytes(reinterpret_cast<const char*>(out.data()), out.size());
   }
 
   void load_state(const py::bytes& data) {
     const std::string_view view = data;
-    std::string error;
-    bool ok;
-    {
-      py::gil_scoped_release release;
-      ok = env().load_state(reinterpret_cast<const uint8_t*>(view.data()), view.size(), &error);
-    }
-    if (!ok) raise_value_error(error);
+    const std::string error = locked([&](kage::Env& e) {
+      std::string error;
+      return e.load_state(reinterpret_cast<const uint8_t*>(view.data()), view.size(), &error) ? std::string() : error;
+    });
+    if (!error.empty()) raise_value_error(error);
   }
 
   void synchronize() {
-    std::string error;
-    if (!env().synchronize(&error)) raise_step_error(error);
+    raise_if_failed(locked([&](kage::Env& e) {
+      Outcome o;
+      o.ok = e.synchronize(&o.error);
+      o.kind = e.last_error_kind();
+      return o;
+    }));
   }
-  std::string pending_error() { return env().pending_error(); }
+  std::string pending_error() {
+    return locked([](kage::Env& e) { return e.pending_error(); });
+  }
 
-  int32_t num_envs() const { return env().num_envs(); }
-  int32_t height() const { return env().height(); }
-  int32_t width() const { return env().width(); }
-  std::string spec_hash() const { return env().spec_hash(); }
-  std::string device() const { return env().backend() == kage::Backend::kGpu ? "cuda" : "cpu"; }
-  uintptr_t stream() const { return reinterpret_cast<uintptr_t>(env().stream()); }
-  void set_stream(uintptr_t s) { env().set_stream(reinterpret_cast<void*>(s)); }
-  void close() { env_.reset(); }
-  bool closed() const { return env_ == nullptr; }
+  int32_t num_envs() const {
+    return locked([](kage::Env& e) { return e.num_envs(); });
+  }
+  int32_t height() const {
+    return locked([](kage::Env& e) { return e.height(); });
+  }
+  int32_t width() const {
+    return locked([](kage::Env& e) { return e.width(); });
+  }
+  std::string spec_hash() const {
+    return locked([](kage::Env& e) { return e.spec_hash(); });
+  }
+  std::string device() const {
+    return locked([](kage::Env& e) { return std::string(e.backend() == kage::Backend::kGpu ? "cuda" : "cpu"); });
+  }
+  uintptr_t stream() const {
+    return locked([](kage::Env& e) { return reinterpret_cast<uintptr_t>(e.stream()); });
+  }
+  void set_stream(uintptr_t s) {
+    locked([&](kage::Env& e) {
+      e.set_stream(reinterpret_cast<void*>(s));
+      return 0;
+    });
+  }
+
+  /// Drops this handle's reference to the batch, after any call in progress on another thread; the
+  /// batch is freed now unless exported arrays still view it. Closing twice is harmless.
+  void close() {
+    py::gil_scoped_release release;
+    std::shared_ptr<kage::Env> dropped;
+    {
+      std::lock_guard<std::mutex> lock(*mutex_);
+      dropped = std::move(env_);
+    }
+    dropped.reset();  // without the GIL: a GPU batch waits for its queued work here
+  }
+  bool closed() const {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(*mutex_);
+    return env_ == nullptr;
+  }
 
  private:
-  kage::Env& env() const {
+  struct Located {
+    const void* data;
+    std::vector<int64_t> shape;
+    kage::DType dtype;
+  };
+
+  /// What a reset, step or synchronize returned, read under the lock.
+  struct Outcome {
+    bool ok = true;
+    std::string error;
+    kage::ErrorKind kind = kage::ErrorKind::kNone;
+  };
+
+  /// f(env) with the GIL released and the batch's lock held; raises if the batch is closed.
+  template <class F>
+  std::invoke_result_t<F, kage::Env&> locked(F&& f) const {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(*mutex_);
     if (!env_) throw std::runtime_error("this environment is closed: make a new one with kage.make_vec");
-    return *env_;
+    return f(*env_);
   }
 
-  void check_length(py::ssize_t n, const char* what) const {
-    if (n != env().num_envs())
-      raise_value_error(std::string(what) + ": expected " + std::to_string(env().num_envs()) + " values (one per "
-                        "environment), got " + std::to_string(n));
+  static Located locate(kage::Env& env, const std::string& name) {
+    const int64_t n = env.num_envs();
+    Located l{nullptr, {n}, kage::DType::kUInt8};
+    if (name == "obs" || name == "final_obs") {
+      l.shape = {n, env.height(), env.width(), 3};
+      l.data = name == "obs" ? env.obs() : env.final_obs();
+    } else if (name == "reward") {
+      l.data = env.reward();
+      l.dtype = kage::DType::kFloat32;
+    } else if (name == "terminated") {
+      l.data = env.terminated();
+    } else if (name == "truncated") {
+      l.data = env.truncated();
+    } else if (name == "final_mask") {
+      l.data = env.final_mask();
+    } else {
+      const bool final = name.rfind("final_info/", 0) == 0;
+      const std::string field = name.substr(name.find('/') + 1);
+      int32_t count = 0;
+      const kage::InfoFieldDesc* fields = kage::info_fields(&count);
+      for (int32_t i = 0; i < count && !l.data; ++i) {
+        if (field != fields[i].name) continue;
+        l.data = final ? env.final_info(fields[i].field) : env.info(fields[i].field);
+        l.dtype = fields[i].dtype;
+      }
+      if (!l.data) raise_value_error("no output named '" + name + "'");
+    }
+    return l;
+  }
+
+  static py::object export_array(const std::shared_ptr<kage::Env>& owner, const void* data,
+                                 const std::vector<int64_t>& shape, kage::DType dtype) {
+    if (owner->backend() == kage::Backend::kGpu) return py::cast(DeviceArray(owner, data, shape, dtype));
+    // Host memory: a numpy view whose base keeps the batch alive.
+    auto* keep = new std::shared_ptr<kage::Env>(owner);
+    py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<kage::Env>*>(p); });
+    std::vector<py::ssize_t> strides(shape.size());
+    py::ssize_t stride = static_cast<py::ssize_t>(facts(dtype).bytes);
+    for (size_t i = shape.size(); i-- > 0;) {
+      strides[i] = stride;
+      stride *= shape[i];
+    }
+    return py::array(numpy_dtype(dtype), std::vector<py::ssize_t>(shape.begin(), shape.end()), strides, data, base);
+  }
+
+  static void check_length(py::ssize_t got, int32_t n, const char* what) {
+    if (got != n)
+      raise_value_error(std::string(what) + ": expected " + std::to_string(n) + " values (one per environment), got " +
+                        std::to_string(got));
   }
 
   static std::string shape_text(const DLTensor& d) {
@@ -333,24 +393,27 @@ class PyEnv {
 
   /// A failed reset, step or synchronize, raised by the kind the runtime reports: an action outside 0..7 as
   /// the package's usage error class (ValueError), anything else as its other class (RuntimeError).
-  void raise_step_error(const std::string& error) const {
+  static void raise_if_failed(const Outcome& o) {
+    if (o.ok) return;
     const ErrorClasses& e = error_classes();
-    const py::object& cls = env().last_error_kind() == kage::ErrorKind::kAction ? e.usage : e.other;
-    PyErr_SetObject(cls.ptr(), py::str(error).ptr());
+    const py::object& cls = o.kind == kage::ErrorKind::kAction ? e.usage : e.other;
+    PyErr_SetObject(cls.ptr(), py::str(o.error).ptr());
     throw py::error_already_set();
   }
 
+  static Outcome step_locked(kage::Env& e, const kage::Actions& a) {
+    Outcome o;
+    o.ok = e.step(a, &o.error);
+    o.kind = e.last_error_kind();
+    return o;
+  }
+
   void run_step(const kage::Actions& a) {
-    std::string error;
-    bool ok;
-    {
-      py::gil_scoped_release release;
-      ok = env().step(a, &error);
-    }
-    if (!ok) raise_step_error(error);
+    raise_if_failed(locked([&](kage::Env& e) { return step_locked(e, a); }));
   }
 
   std::shared_ptr<kage::Env> env_;
+  std::shared_ptr<std::mutex> mutex_;  // shared: PyEnv is moved once, out of open_env
 };
 
 PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& device, int32_t num_threads,

@@ -6,6 +6,7 @@ stays allocated while it exists, but its contents are overwritten by the next ``
 copy what you keep (``obs.copy()``, ``tensor.clone()``).
 """
 import os
+import threading
 from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -47,12 +48,20 @@ class VecEnv:
     same step. The step returns the finishing step's reward and flags, the new episode's first
     observation and info, and the finished episode in ``info["final_obs"]`` and ``info["final_info"]``
     (a dict of the same fields), where ``info["_final"]`` is 1. Rows where ``_final`` is 0 are stale.
+
+    Threads: a batch may be used from any thread, and calls from several threads run one at a time, each
+    one whole (a step's state is never torn, ``save_state`` never sees half a step). ``close()`` (and
+    deleting or collecting the batch) waits for a call in progress on another thread; later calls raise
+    ``RuntimeError``. The outputs are one set of views for all threads: a thread that reads them while
+    another steps sees that step's values, so give a batch to one thread at a time, or copy what you keep.
+    On the GPU, closing waits for the device's queued work before the batch's memory is freed.
     """
 
     metadata = {"autoreset_mode": "same-step"}
 
     def __init__(self, handle: "kage._kage.Env", config: str, seed: int, asset_root: Optional[str] = None):
         self._handle = handle
+        self._lock = threading.Lock()  # one call at a time (see Threads above)
         self.config = config
         self._asset_root = asset_root
         self._spec: Optional[dict] = None
@@ -88,6 +97,10 @@ class VecEnv:
         the others keep their state). ``seed``: an int (each environment gets its own seed from it,
         see ``env_seeds``), ``num_envs`` ints (the environments' own seeds), or None (make_vec's seed
         on the first call, then a fresh draw from it on each later call)."""
+        with self._lock:
+            return self._reset(seed, options)
+
+    def _reset(self, seed: Seed, options: Optional[Dict[str, Any]]) -> Tuple[Any, Dict[str, Any]]:
         handle = self._live()
         if seed is None:
             seeds = np.random.SeedSequence([self._seed, self._resets_without_seed]).generate_state(
@@ -112,26 +125,30 @@ class VecEnv:
     def step(self, actions) -> Tuple[Any, Any, Any, Any, Dict[str, Any]]:
         """One step of every environment; ``actions``: [num_envs] integers in 0..7 (numpy, torch,
         JAX, CuPy, ...; read in place on the GPU)."""
-        handle = self._live()
-        _actions.submit(handle, actions)
-        # The runtime reads device actions when its kernel runs: keep them alive until the next step.
-        self._last_actions = actions
-        return self._obs, self._reward, self._terminated, self._truncated, self._info_dict()
+        with self._lock:
+            handle = self._live()
+            _actions.submit(handle, actions)
+            # The runtime reads device actions when its kernel runs: keep them alive until the next step.
+            self._last_actions = actions
+            return self._obs, self._reward, self._terminated, self._truncated, self._info_dict()
 
     def outputs(self) -> Tuple[Any, Any, Any, Any, Dict[str, Any]]:
         """The arrays of the last reset or step, (obs, reward, terminated, truncated, info), without
         stepping: the same views every call, so a learner can take them once and read them each step."""
-        self._live()
-        return self._obs, self._reward, self._terminated, self._truncated, self._info_dict()
+        with self._lock:
+            self._live()
+            return self._obs, self._reward, self._terminated, self._truncated, self._info_dict()
 
     def close(self) -> None:
         """Releases the environments. Arrays and tensors still viewing their outputs keep that memory
-        alive until they are dropped. Closing twice is harmless; any other use raises."""
-        if self._handle is not None:
-            self._handle.close()
-        self._handle = None
-        self._obs = self._reward = self._terminated = self._truncated = self._info = self._final = None
-        self._last_actions = None
+        alive until they are dropped. Closing twice is harmless; any other use raises. Waits for a call
+        in progress on another thread."""
+        with self._lock:
+            if self._handle is not None:
+                self._handle.close()
+            self._handle = None
+            self._obs = self._reward = self._terminated = self._truncated = self._info = self._final = None
+            self._last_actions = None
 
     def __enter__(self) -> "VecEnv":
         return self
@@ -145,17 +162,20 @@ class VecEnv:
         """The whole batch's state and last outputs (about 1.4 KB per environment); waits for queued
         work. ``load_state`` on a batch of the same config and size, on either device, continues
         exactly as this one would."""
-        return self._live().save_state()
+        with self._lock:
+            return self._live().save_state()
 
     def load_state(self, state: bytes) -> Tuple[Any, Dict[str, Any]]:
         """Restores ``save_state``'s bytes and returns the restored (obs, info)."""
-        self._live().load_state(state)
-        return self._obs, self._info_dict()
+        with self._lock:
+            self._live().load_state(state)
+            return self._obs, self._info_dict()
 
     def synchronize(self) -> None:
         """Waits for the batch's queued GPU work; raises ValueError if an earlier step had an
         out-of-range device action."""
-        self._live().synchronize()
+        with self._lock:
+            self._live().synchronize()
 
     @property
     def stream(self) -> int:
