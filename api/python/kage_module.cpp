@@ -158,16 +158,24 @@ class PyEnv {
     return locked([&](kage::Env& e) { return reinterpret_cast<uintptr_t>(locate(e, name).data); });
   }
 
-  void reset(py::array_t<uint64_t, py::array::c_style | py::array::forcecast> seeds, const py::object& mask) {
+  /// `seeds`: num_envs uint64 values; `mask`: None or num_envs bools (or uint8 0/1). Any strides, byte order
+  /// or alignment: each is copied into a native contiguous array first; other dtypes are refused, not cast.
+  void reset(const py::array& seeds, const py::object& mask) {
     const int32_t n = num_envs();
-    check_length(seeds.size(), n, "seeds");
+    check_dtype(seeds, "seeds", seeds.dtype().kind() == 'u' && seeds.dtype().itemsize() == 8, "uint64");
+    const auto native_seeds = py::array_t<uint64_t, py::array::c_style | py::array::forcecast>::ensure(seeds);
+    check_length(native_seeds.size(), n, "seeds");
     std::vector<uint8_t> m;
     if (!mask.is_none()) {
-      auto a = mask.cast<py::array_t<uint8_t, py::array::c_style | py::array::forcecast>>();
+      const py::array given = py::array::ensure(mask);
+      if (!given) raise_value_error("mask: a numpy array of booleans");
+      const py::dtype dt = given.dtype();
+      check_dtype(given, "mask", dt.kind() == 'b' || (dt.kind() == 'u' && dt.itemsize() == 1), "bool or uint8");
+      const auto a = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>::ensure(given);
       check_length(a.size(), n, "mask");
       m.assign(a.data(), a.data() + a.size());
     }
-    const uint64_t* s = seeds.data();
+    const uint64_t* s = native_seeds.data();
     raise_if_failed(locked([&](kage::Env& e) {
       Outcome o;
       o.ok = e.reset(s, m.empty() ? nullptr : m.data(), &o.error);
@@ -176,12 +184,23 @@ class PyEnv {
     }));
   }
 
-  /// Host actions: int32 or int64, C-contiguous, num_envs values (checked by the Python side).
+  /// Host actions: num_envs int32 or int64 values in native byte order, aligned, any stride that is a
+  /// multiple of the item size (kage.actions copies other layouts first); other layouts are refused by name.
   void step_host(const py::array& actions) {
     const auto& dt = actions.dtype();
     if ((dt.kind() != 'i') || (dt.itemsize() != 4 && dt.itemsize() != 8) || actions.ndim() != 1)
       raise_value_error("internal: step_host wants a 1-D int32 or int64 array");
     check_length(actions.size(), num_envs(), "actions");
+    const py::ssize_t size = dt.itemsize(), stride = actions.strides(0);
+    const std::string fix = ": pass np.ascontiguousarray(actions, dtype=np.int64)";
+    if (stride % size != 0)
+      raise_value_error("actions: a byte stride " + std::to_string(stride) + " is not a multiple of the item size " +
+                        std::to_string(size) + " (a field of a packed structured array?)" + fix);
+    if (reinterpret_cast<uintptr_t>(actions.data()) % static_cast<uintptr_t>(size) != 0)
+      raise_value_error("actions: the data is not aligned to the item size " + std::to_string(size) + fix);
+    if (!dt.attr("isnative").cast<bool>())
+      raise_value_error("actions: int" + std::to_string(8 * size) + " in the other byte order than this machine's" +
+                        fix);
     run_step(kage::Actions{actions.data(), kage::Memory::kHost,
                            dt.itemsize() == 8 ? kage::DType::kInt64 : kage::DType::kInt32,
                            actions.strides(0) / dt.itemsize()});
@@ -193,6 +212,9 @@ class PyEnv {
     if (device() != "cuda")
       raise_value_error("actions are in GPU memory but the environment runs on the CPU: pass host actions "
                         "(e.g. actions.cpu()) or make the environment with device='cuda'");
+    if (ptr % (is_int64 ? 8 : 4) != 0)
+      raise_value_error("actions: device data at " + std::to_string(ptr) + " is not aligned to the item size: pass "
+                        "a contiguous copy (e.g. actions.contiguous())");
     const kage::Actions a{reinterpret_cast<const void*>(ptr), kage::Memory::kDevice,
                           is_int64 ? kage::DType::kInt64 : kage::DType::kInt32, stride};
     raise_if_failed(locked([&](kage::Env& e) {
@@ -221,6 +243,8 @@ class PyEnv {
     else if (d.dtype.lanes != 1 || d.dtype.code != kDLInt || (d.dtype.bits != 32 && d.dtype.bits != 64))
       problem = "actions of DLPack type (code " + std::to_string(d.dtype.code) + ", " + std::to_string(d.dtype.bits) +
                 " bits), expected int32 or int64";
+    else if ((reinterpret_cast<uintptr_t>(d.data) + d.byte_offset) % (d.dtype.bits / 8) != 0)
+      problem = "actions: device data not aligned to the item size: pass a contiguous copy (e.g. actions.contiguous())";
     const kage::Actions a{static_cast<const char*>(d.data) + d.byte_offset, kage::Memory::kDevice,
                           d.dtype.bits == 64 ? kage::DType::kInt64 : kage::DType::kInt32,
                           d.strides ? d.strides[0] : 1};
@@ -248,11 +272,18 @@ class PyEnv {
     return py::bytes(reinterpret_cast<const char*>(out.data()), out.size());
   }
 
-  void load_state(const py::bytes& data) {
-    const std::string_view view = data;
+  /// `data`: a contiguous buffer of bytes (bytes, bytearray, memoryview, uint8 array; read-only is fine).
+  void load_state(const py::buffer& data) {
+    const py::buffer_info b = data.request();
+    if (b.itemsize != 1 || b.ndim != 1 || b.strides[0] != 1)
+      raise_value_error("load_state: a contiguous buffer of bytes (bytes, bytearray, memoryview), got item size " +
+                        std::to_string(b.itemsize) + ", " + std::to_string(b.ndim) + " dimensions" +
+                        (b.ndim == 1 ? ", byte stride " + std::to_string(b.strides[0]) : std::string()));
+    const auto* bytes = static_cast<const uint8_t*>(b.ptr);
+    const size_t size = static_cast<size_t>(b.size);
     const std::string error = locked([&](kage::Env& e) {
       std::string error;
-      return e.load_state(reinterpret_cast<const uint8_t*>(view.data()), view.size(), &error) ? std::string() : error;
+      return e.load_state(bytes, size, &error) ? std::string() : error;
     });
     if (!error.empty()) raise_value_error(error);
   }
@@ -377,6 +408,12 @@ class PyEnv {
       stride *= shape[i];
     }
     return py::array(numpy_dtype(dtype), std::vector<py::ssize_t>(shape.begin(), shape.end()), strides, data, base);
+  }
+
+  /// Refuses an array of another element type than `expected`, rather than casting its values.
+  static void check_dtype(const py::array& a, const char* what, bool ok, const char* expected) {
+    if (!ok)
+      raise_value_error(std::string(what) + ": " + expected + " values, got " + py::str(a.dtype()).cast<std::string>());
   }
 
   static void check_length(py::ssize_t got, int32_t n, const char* what) {

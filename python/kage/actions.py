@@ -64,9 +64,11 @@ def _step_host(handle, a: np.ndarray, n: int) -> None:
     if a.dtype.kind not in "iu":
         raise ValueError(f"actions of dtype {a.dtype}, expected an integer dtype (int32 or int64): "
                          f"{native().action_range_text()}")
-    if a.dtype not in (np.int32, np.int64):
-        # int64 holds every other integer kind's values (uint64 above 2**63 turns negative: still refused),
-        # so the runtime's range check sees them unchanged.
+    if a.dtype not in (np.int32, np.int64) or not a.flags.aligned:
+        # A native, aligned int64 copy: the binding reads only native int32/int64 whose byte stride is a
+        # multiple of the item size, so a field of a packed structured array, another byte order or a
+        # misaligned buffer is copied here. int64 holds every other integer kind's values (uint64 above 2**63
+        # turns negative: still refused), so the runtime's range check sees them unchanged.
         a = a.astype(np.int64)
     handle.step_host(a)
 
@@ -78,6 +80,11 @@ def _step_cuda_array_interface(handle, cai: dict, n: int) -> None:
         raise ValueError(f"actions of type {typestr}, expected int32 (<i4) or int64 (<i8) on the GPU")
     itemsize = int(typestr[-1])
     strides = cai.get("strides")
+    if strides is not None and strides[0] % itemsize:
+        raise ValueError(f"actions: a byte stride {strides[0]} is not a multiple of the item size {itemsize}: pass a "
+                         "contiguous copy")
+    if cai.get("mask") is not None:
+        raise ValueError("actions: a masked __cuda_array_interface__ array: pass one without a mask")
     stride = 1 if strides is None else strides[0] // itemsize
     ptr, _ = cai["data"]
     stream = cai.get("stream")

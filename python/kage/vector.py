@@ -34,6 +34,19 @@ def _explicit_seeds(seed, num_envs: int) -> np.ndarray:
     return np.array([int(v) for v in values], dtype=np.uint64)
 
 
+def _state_bytes(state) -> Any:
+    """A saved state as a contiguous buffer of bytes, without a copy where it is one already."""
+    try:
+        view = memoryview(state)
+    except TypeError:
+        view = None
+    if view is None or view.itemsize != 1 or view.format not in ("B", "b", "c"):
+        what = type(state).__name__ if view is None else f"{type(state).__name__} of format {view.format!r}"
+        raise ValueError(f"load_state: expects the bytes of save_state() (bytes, bytearray, memoryview or a uint8 "
+                         f"array), got {what}")
+    return view if view.c_contiguous and view.ndim == 1 else view.tobytes()
+
+
 class VecEnv:
     """``num_envs`` environments of one configuration, stepped together.
 
@@ -166,9 +179,11 @@ class VecEnv:
             return self._live().save_state()
 
     def load_state(self, state: bytes) -> Tuple[Any, Dict[str, Any]]:
-        """Restores ``save_state``'s bytes and returns the restored (obs, info)."""
+        """Restores ``save_state``'s bytes and returns the restored (obs, info). ``state``: bytes or any
+        bytes-like object (bytearray, memoryview, a uint8 numpy array; strided or read-only is fine)."""
+        data = _state_bytes(state)
         with self._lock:
-            self._live().load_state(state)
+            self._live().load_state(data)
             return self._obs, self._info_dict()
 
     def synchronize(self) -> None:
