@@ -21,6 +21,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     report.add_argument("--protocol", choices=("max", "final"), default="max",
                         help="a run's value: its maximum over training (the paper's) or its last evaluation")
     report.add_argument("--reps", type=int, default=50000, help="bootstrap resamples of the interval estimates")
+    report.add_argument("--partial", action="store_true",
+                        help="an interim report: unfinished runs too, at their latest evaluation (default DIR/report_interim)")
     if argv[:1] == ["run"]:
         from kage.bench import run
         return run.main(argv[1:])
@@ -39,7 +41,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         status_module.status(args.dir, sys.stdout)
         return 0
     from kage.bench import report as report_module
-    written = report_module.report(args.dir, args.out, args.protocol, args.reps)
+    written = report_module.report(args.dir, args.out, args.protocol, args.reps, args.partial)
     print(f"kage.bench report: wrote {written['out_dir']}", file=sys.stderr)
     return 0
 

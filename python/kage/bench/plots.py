@@ -20,6 +20,8 @@ runs are unfinished. The drop bars have no error bars: the drop is a ratio of tw
 pairs, whose errors are correlated, and the per-axis table gives each mean's SEM. An undefined drop (train
 success 0, or no finished run) is a missing bar marked n/a.
 
+Every function takes `interim`: the line an interim report (--partial) prints in red above the figure.
+
 matplotlib is imported when a figure is drawn, and draws through its Agg canvas without pyplot, so no
 display or backend setting is involved.
 """
@@ -48,14 +50,17 @@ def legend(ax) -> None:
         ax.legend(fontsize=8)
 
 
-def png_bytes(figure) -> bytes:
+def png_bytes(figure, interim: Optional[str] = None) -> bytes:
+    """The figure as PNG; an interim report's figure says so above everything, in red."""
+    if interim:
+        figure.text(0.5, 1.0, interim, color="#b00000", ha="center", va="bottom", fontsize=8)
     out = io.BytesIO()
     figure.savefig(out, format="png", dpi=DPI, bbox_inches="tight")
     return out.getvalue()
 
 
 def training_curves(title: str, train: Sequence[Tuple[float, dict]], evaluated: Sequence[Tuple[float, dict]],
-                    ylabel: str, ylim: Optional[Tuple[float, float]] = None) -> bytes:
+                    ylabel: str, ylim: Optional[Tuple[float, float]] = None, interim: Optional[str] = None) -> bytes:
     """Train and Eval curves from [(global_step, {"mean", "sem", "n"})], steps in millions."""
     figure, ax = new_figure()
     for name, points, colour in (("Train", train, TRAIN_COLOUR), ("Eval", evaluated, EVAL_COLOUR)):
@@ -73,10 +78,10 @@ def training_curves(title: str, train: Sequence[Tuple[float, dict]], evaluated: 
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     legend(ax)
-    return png_bytes(figure)
+    return png_bytes(figure, interim)
 
 
-def drop_per_axis(axes: List[str], drops: List[Optional[float]]) -> bytes:
+def drop_per_axis(axes: List[str], drops: List[Optional[float]], interim: Optional[str] = None) -> bytes:
     """One bar per axis: the success_once drop in percent; None is a missing bar marked n/a."""
     figure, ax = new_figure()
     positions = range(len(axes))
@@ -90,10 +95,11 @@ def drop_per_axis(axes: List[str], drops: List[Optional[float]]) -> bytes:
     ax.set_title("success_once drop per axis, 100 (train - eval) / train", fontsize=10)
     if None in drops:
         ax.set_xlabel("n/a: train success 0, or no finished run", fontsize=8)
-    return png_bytes(figure)
+    return png_bytes(figure, interim)
 
 
-def sweep_response(title: str, names: List[str], evaluated: List[dict], train: dict) -> bytes:
+def sweep_response(title: str, names: List[str], evaluated: List[dict], train: dict,
+                   interim: Optional[str] = None) -> bytes:
     """Eval success_once ({"mean", "sem"} per eval config) against the swept value: float(name) where every
     name is a number, else the names in order; the train config's value as a dashed line with its SEM band."""
     figure, ax = new_figure()
@@ -116,10 +122,10 @@ def sweep_response(title: str, names: List[str], evaluated: List[dict], train: d
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     legend(ax)
-    return png_bytes(figure)
+    return png_bytes(figure, interim)
 
 
-def interval_estimates(methods: Dict[str, List[dict]]) -> bytes:
+def interval_estimates(methods: Dict[str, List[dict]], interim: Optional[str] = None) -> bytes:
     """Per row of kage.bench.intervals (the axes, then all pairs), a bar over each method's 95 % interval and a
     black tick at its point: the IQM of eval success on the left, the drop (%) on the right. `methods` maps a
     name ("" for the report's one method) to its rows, the same rows in the same order for every method."""
@@ -146,10 +152,11 @@ def interval_estimates(methods: Dict[str, List[dict]]) -> bytes:
     panels[1].axvline(0, color="black", linewidth=0.8)
     figure.suptitle("95 % bootstrap intervals (bars) and point estimates (ticks)", fontsize=10)
     legend(panels[0])
-    return png_bytes(figure)
+    return png_bytes(figure, interim)
 
 
-def performance_profiles(taus: Sequence[float], curves: Dict[str, dict], dashed: Sequence[str] = ()) -> bytes:
+def performance_profiles(taus: Sequence[float], curves: Dict[str, dict], dashed: Sequence[str] = (),
+                         interim: Optional[str] = None) -> bytes:
     """Per curve ({"point", "low", "high"} per threshold), the fraction of runs whose success exceeds each
     threshold tau, with its 95 % band; the curves named in `dashed` drawn dashed."""
     figure, ax = new_figure()
@@ -163,4 +170,4 @@ def performance_profiles(taus: Sequence[float], curves: Dict[str, dict], dashed:
     ax.set_title("performance profile of success (95 % bands)", fontsize=10)
     ax.grid(alpha=0.3)
     legend(ax)
-    return png_bytes(figure)
+    return png_bytes(figure, interim)

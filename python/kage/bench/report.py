@@ -31,8 +31,13 @@ Beside these, interval estimates of success (kage.bench.intervals, after rliable
 pairs, the IQM of eval and train success with 95 % stratified-bootstrap intervals and the drop with a paired
 ratio bootstrap, and the performance profile of eval success.
 
-Only finished runs (with summary.json) enter the tables; unfinished ones are counted and listed. A pair,
-sweep or axis without a finished run appears with n = 0 and empty values. A side's mean is over the values
+Only finished runs (with summary.json) enter the tables; unfinished ones are counted and listed. With `partial`
+(--partial), unfinished runs enter too, scored over the evaluation points they have logged (their maximum, or
+their latest under "final"): an interim report, written by default into DIR/report_interim/ (report_final_interim/
+under "final") so that it never replaces the final one. Every Markdown file of an interim report is titled
+interim and lists how far each unfinished run got (evaluations, latest step, of how many); every CSV gets a first
+column "interim"; every plot says so in red above it. A pair, sweep or axis without a run in the tables appears
+with n = 0 and empty values. A side's mean is over the values
 that exist: return and length are null where every listed episode returned exactly 0; report.json gives
 each side's n.
 
@@ -230,13 +235,22 @@ def flat_row(row: dict) -> Dict[str, Optional[float]]:
     return {k: (float(v) if is_number(v) else None) for k, v in flat.items()}
 
 
-def run_values(run: Run, protocol: str) -> Optional[Dict[str, Optional[float]]]:
-    """A finished run's value per summary key under `protocol`: "max", summary.json's maxima; "final", its last
-    evaluation row. None for an unfinished run."""
-    if run.stats is None:
+def run_values(run: Run, protocol: str, partial: bool = False) -> Optional[Dict[str, Optional[float]]]:
+    """A run's value per summary key under `protocol`: "max", summary.json's maxima (over the rows logged so far
+    for an unfinished run); "final", its last evaluation row. None for a run that is not in the tables: an
+    unfinished one, unless `partial` and it has an evaluation row."""
+    if run.stats is None and not (partial and run.evaluations):
         return None
-    if protocol == "max":
+    if protocol == "max" and run.stats is not None:
         return {k: (None if v is None else float(v["max"])) for k, v in run.stats.items()}
+    if protocol == "max":
+        series: Dict[str, List[float]] = {}
+        for row in run.evaluations:
+            for key, value in flat_row(row).items():
+                series.setdefault(key, [])
+                if value is not None:
+                    series[key].append(value)
+        return {key: (max(values) if values else None) for key, values in series.items()}
     if not run.evaluations:
         fail(f"{os.path.join(run.path, 'metrics.jsonl')} has no evaluation row, which --protocol final reads: use "
              "--protocol max, or delete the run directory and rerun `python3 -m kage.bench run`")
@@ -296,34 +310,35 @@ def sweep_order(names: List[str]) -> List[str]:
         return list(names)
 
 
-def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "max") -> dict:
+def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "max", partial: bool = False) -> dict:
     """The three levels: {"runs": level 1, "pairs": level 2 (plain pairs), "axes": level 3, "sweeps": level 2
-    per sweep}; `protocol` chooses a run's value (run_values)."""
+    per sweep}; `protocol` and `partial` choose the runs and their values (run_values)."""
     level1, pairs, sweeps = [], [], []
     for unit in units:
-        scored = [(r, v) for r in runs[unit.name] for v in [run_values(r, protocol)] if v is not None]
-        finished = [r for r, _ in scored]
+        scored = [(r, v) for r in runs[unit.name] for v in [run_values(r, protocol, partial)] if v is not None]
+        included = [r for r, _ in scored]
         results = {}
         for pair in unit.pairs:
             label = unit.label(pair)
             per_run = []
             for run, run_value in scored:
-                where = os.path.join(run.path, "summary.json" if protocol == "max" else "metrics.jsonl")
+                from_summary = protocol == "max" and run.stats is not None
+                where = os.path.join(run.path, "summary.json" if from_summary else "metrics.jsonl")
                 values = run_scores(run_value, label, where)
                 level1.append({"pair": pair["pair"], "unit": unit.name, "seed": run.seed, "label": label,
-                               "path": run.path, "metrics": values})
+                               "path": run.path, **progress(run), "metrics": values})
                 per_run.append(values)
             results[pair["pair"]] = {
                 "pair": pair["pair"], "axis": pair["declared_axis"], "certified": pair.get("certified"),
-                "n_seeds": len(finished), "seeds": [r.seed for r in finished], "metrics": over_seeds(per_run)}
+                "n_seeds": len(included), "seeds": [r.seed for r in included], "metrics": over_seeds(per_run)}
         if not unit.is_sweep:
             pairs.extend(results[p["pair"]] for p in unit.pairs)
             continue
         by_name = {p["sweep_eval"]: results[p["pair"]] for p in unit.pairs}
         evals = [dict(by_name[name], sweep_eval=name) for name in sweep_order(list(by_name))]
         sweeps.append({"sweep": unit.name, "axis": unit.pairs[0]["declared_axis"],
-                       "train_config": unit.pairs[0]["train"].get("name"), "n_seeds": len(finished),
-                       "seeds": [r.seed for r in finished], "evals": evals})
+                       "train_config": unit.pairs[0]["train"].get("name"), "n_seeds": len(included),
+                       "seeds": [r.seed for r in included], "evals": evals})
     return {"runs": level1, "pairs": pairs, "axes": axes_of(pairs), "sweeps": sweeps}
 
 
@@ -341,8 +356,17 @@ def axes_of(pairs: List[dict]) -> List[dict]:
     return axes
 
 
-def run_status(units: List[Unit], runs: Dict[str, List[Run]], seeds: List[int]) -> dict:
-    """Finished runs, unfinished ones (not in the tables) and seeds of bench.json without a run directory."""
+def progress(run: Run) -> dict:
+    """How far a run got: finished or not, its evaluation points, the latest one's step, and its total steps."""
+    total = run.args.get("total_timesteps")
+    return {"finished": run.stats is not None, "evaluations": len(run.evaluations),
+            "step": run.evaluations[-1]["global_step"] if run.evaluations else None,
+            "total_steps": total if is_number(total) else None}
+
+
+def run_status(units: List[Unit], runs: Dict[str, List[Run]], seeds: List[int], partial: bool = False) -> dict:
+    """Finished runs, unfinished ones (in the tables with `partial` where they have an evaluation point) and
+    seeds of bench.json without a run directory."""
     finished, unfinished, not_started = 0, [], []
     for unit in units:
         found = {r.seed for r in runs[unit.name]}
@@ -350,9 +374,25 @@ def run_status(units: List[Unit], runs: Dict[str, List[Run]], seeds: List[int]) 
             if run.stats is not None:
                 finished += 1
             else:
-                unfinished.append({"unit": unit.name, "seed": run.seed, "path": run.path})
+                unfinished.append({"unit": unit.name, "seed": run.seed, "path": run.path, **progress(run),
+                                   "in_tables": partial and bool(run.evaluations)})
         not_started += [{"unit": unit.name, "seed": s} for s in seeds if s not in found]
-    return {"finished": finished, "unfinished": unfinished, "not_started": not_started}
+    return {"finished": finished, "unfinished": unfinished, "not_started": not_started, "partial": partial}
+
+
+def interim_line(status: dict) -> Optional[str]:
+    """An interim report's one-line mark for its plots; None for a report of finished runs only."""
+    included = [r for r in status["unfinished"] if r["in_tables"]]
+    if not status["partial"]:
+        return None
+    if not included:
+        return "INTERIM (--partial): no unfinished run has an evaluation yet"
+    steps = [r["step"] for r in included]
+    totals = {r["total_steps"] for r in included}
+    of = f" of {totals.pop() / 1e6:.3g} M" if len(totals) == 1 and None not in totals else ""
+    reached = f"{min(steps) / 1e6:.3g}" + (f"-{max(steps) / 1e6:.3g}" if max(steps) > min(steps) else "")
+    return (f"INTERIM (--partial): {len(included)} unfinished runs included at their latest evaluation, "
+            f"{reached} M steps{of}")
 
 
 # ---- plots ----
@@ -370,8 +410,9 @@ def curve(evaluations: List[List[dict]], label: Optional[str], metric: str) -> L
 
 
 def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], levels: dict,
-                estimates: Optional[dict]) -> List[str]:
-    """The PNG files under plots/ (see kage.bench.plots); returns their names relative to out_dir."""
+                estimates: Optional[dict], interim: Optional[str] = None) -> List[str]:
+    """The PNG files under plots/ (see kage.bench.plots), each marked with `interim` where given; returns their
+    names relative to out_dir."""
     figures: Dict[str, bytes] = {}
     for unit in units:
         evaluations = [r.evaluations for r in runs[unit.name] if r.evaluations]
@@ -384,19 +425,20 @@ def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], lev
                                                  ("return", "_return", "return", None)):
                 figures[f"plots/curves_{safe(pair['pair'])}{suffix}.png"] = plots.training_curves(
                     title, curve(evaluations, None, metric), curve(evaluations, unit.label(pair), metric), ylabel,
-                    ylim)
+                    ylim, interim)
     if levels["axes"]:
         drops = [a["metrics"][SUCCESS_SHOWN]["drop_pct"] for a in levels["axes"]]
-        figures["plots/drop_per_axis.png"] = plots.drop_per_axis([a["axis"] for a in levels["axes"]], drops)
+        figures["plots/drop_per_axis.png"] = plots.drop_per_axis([a["axis"] for a in levels["axes"]], drops, interim)
     if estimates and estimates["profile"]:
-        figures["plots/intervals.png"] = plots.interval_estimates({"": estimates["rows"]})
+        figures["plots/intervals.png"] = plots.interval_estimates({"": estimates["rows"]}, interim)
         profile = estimates["profile"]
         figures["plots/profile_success.png"] = plots.performance_profiles(
-            profile["taus"], {"eval": profile["eval"], "train": profile["train"]}, dashed={"train"})
+            profile["taus"], {"eval": profile["eval"], "train": profile["train"]}, dashed={"train"}, interim=interim)
     for s in levels["sweeps"]:
         figures[f"plots/sweep_{safe(s['sweep'])}.png"] = plots.sweep_response(
             f"{s['sweep']} ({s['axis']})", [e["sweep_eval"] for e in s["evals"]],
-            [e["metrics"][SUCCESS_SHOWN]["eval"] for e in s["evals"]], s["evals"][0]["metrics"][SUCCESS_SHOWN]["train"])
+            [e["metrics"][SUCCESS_SHOWN]["eval"] for e in s["evals"]], s["evals"][0]["metrics"][SUCCESS_SHOWN]["train"],
+            interim)
     os.makedirs(os.path.join(out_dir, "plots"), exist_ok=True)
     for name, png in figures.items():
         atomic_write(os.path.join(out_dir, name), png)
@@ -406,20 +448,21 @@ def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], lev
 # ---- the command ----
 
 def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
-           reps: int = intervals.REPS) -> dict:
+           reps: int = intervals.REPS, partial: bool = False) -> dict:
     """Reads the benchmark directory `bench_dir`, writes the tables, plots and report.json into `out_dir`
-    (default bench_dir/report, or report_final under `protocol` "final") and returns report.json's content.
-    `reps`: bootstrap resamples of the interval estimates."""
+    (default bench_dir/report, report_final under `protocol` "final", with "_interim" appended under `partial`)
+    and returns report.json's content. `reps`: bootstrap resamples of the interval estimates."""
     if protocol not in PROTOCOLS:
         fail(f"unknown protocol '{protocol}': choose {' or '.join(PROTOCOLS)}")
     suite = load_suite(bench_dir)
     bench = read_bench(bench_dir)
-    out_dir = out_dir or os.path.join(bench_dir, "report" if protocol == "max" else "report_final")
+    out_dir = out_dir or os.path.join(bench_dir, ("report" if protocol == "max" else "report_final")
+                                      + ("_interim" if partial else ""))
     selected = bench.get("units")  # what `run --pairs` chose, when it chose
     units = [u for u in units_of(suite, bench.get("shared")) if selected is None or u.name in selected]
     runs = {unit.name: find_runs(bench_dir, unit) for unit in units}
-    levels = aggregate(units, runs, protocol)
-    status = run_status(units, runs, [s for s in bench.get("seeds", []) if isinstance(s, int)])
+    levels = aggregate(units, runs, protocol, partial)
+    status = run_status(units, runs, [s for s in bench.get("seeds", []) if isinstance(s, int)], partial)
     result = {
         "kage_bench_report": 1, "suite": suite.get("suite", "suite"), "manifest": suite.get("manifest"),
         "bench_dir": bench_dir, "out_dir": out_dir, "seeds": bench.get("seeds"),
@@ -435,7 +478,7 @@ def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
                             if protocol == "max" else "per run |train - eval| at its last evaluation point",
         },
         "metrics": list(METRICS), "markdown_success_column": SUCCESS_SHOWN,
-        "runs_found": status, "levels": levels,
+        "runs_found": status, "interim": interim_line(status), "levels": levels,
         "intervals": intervals.interval_report(levels["runs"], levels["pairs"], reps) if levels["pairs"] else None,
     }
     try:
@@ -449,10 +492,10 @@ def write_report(out_dir: str, result: dict, units: List[Unit], runs: Dict[str, 
     """The tables, the plots, then report.json (`result`, completed with the files written)."""
     os.makedirs(out_dir, exist_ok=True)
     files = write_tables(out_dir, result["suite"], result["levels"], result["runs_found"],
-                         PROTOCOL_TEXTS[result["protocol"]["score"]], result["intervals"])
+                         PROTOCOL_TEXTS[result["protocol"]["score"]], result["intervals"], result["protocol"]["score"])
     result["plots_note"] = None
     try:
-        files += write_plots(out_dir, units, runs, result["levels"], result["intervals"])
+        files += write_plots(out_dir, units, runs, result["levels"], result["intervals"], result["interim"])
     except ImportError as e:  # the tables do not need matplotlib
         result["plots_note"] = f"no plots: {e}; install matplotlib (pip install matplotlib) and rerun the report"
         print(f"kage.bench report: {result['plots_note']}", file=sys.stderr)

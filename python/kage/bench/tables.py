@@ -42,11 +42,19 @@ def sweeps_csv(sweeps: List[dict]) -> str:
     return csv_text(("sweep", "sweep_eval", "axis", "metric", "n_seeds") + VALUE_COLUMNS + DIFF_COLUMNS, rows)
 
 
-def runs_csv(level1: List[dict]) -> str:
-    rows = [[r["pair"], r["unit"], r["seed"], m, v["train"], v["eval"], v["gap"], v["drop_pct"], v["max_abs_diff"]]
-            for r in level1 for m, v in r["metrics"].items()]
-    return csv_text(("pair", "unit", "seed", "metric", "train_max", "eval_max", "gap", "drop_pct", "max_abs_diff"),
-                    rows)
+def runs_csv(level1: List[dict], score: str = "max") -> str:
+    """One row per run and metric: its values under the protocol `score` ("max" or "final"), whether the run
+    finished, and the step of its latest evaluation."""
+    rows = [[r["pair"], r["unit"], r["seed"], m, v["train"], v["eval"], v["gap"], v["drop_pct"], v["max_abs_diff"],
+             r["finished"], r["step"]] for r in level1 for m, v in r["metrics"].items()]
+    return csv_text(("pair", "unit", "seed", "metric", f"train_{score}", f"eval_{score}", "gap", "drop_pct",
+                     "max_abs_diff", "finished", "step"), rows)
+
+
+def mark_interim(text: str) -> str:
+    """An interim report's CSV: a first column "interim", "yes" on every row."""
+    lines = text.splitlines()
+    return "\n".join(["interim," + lines[0]] + ["yes," + line for line in lines[1:]]) + "\n"
 
 
 # ---- Markdown ----
@@ -134,25 +142,47 @@ def status_text(status: dict) -> str:
         names = [f"{r['unit']} seed {r['seed']}" for r in runs]
         return ", ".join(names[:10]) + (f" and {len(names) - 10} more" if len(names) > 10 else "")
     text = f"Runs: {status['finished']} finished"
-    if status["unfinished"]:
-        text += f"; {len(status['unfinished'])} unfinished, not in the tables: {listed(status['unfinished'])}"
+    inside = [r for r in status["unfinished"] if r.get("in_tables")]
+    outside = [r for r in status["unfinished"] if not r.get("in_tables")]
+    if inside:
+        text += f"; {len(inside)} unfinished, in the tables at their latest evaluation: {listed(inside)}"
+    if outside:
+        why = " (no evaluation yet)" if status.get("partial") else ""
+        text += f"; {len(outside)} unfinished, not in the tables{why}: {listed(outside)}"
     if status["not_started"]:
         text += f"; {len(status['not_started'])} not started: {listed(status['not_started'])}"
     return text + "."
 
 
+def steps_text(steps: Optional[float]) -> str:
+    return "-" if steps is None else f"{steps / 1e6:.3g} M"
+
+
+def interim_text(status: dict) -> str:
+    """An interim report's notice: what it includes, and how far each unfinished run got."""
+    rows = [[r["unit"], r["seed"], r["evaluations"], steps_text(r["step"]), steps_text(r["total_steps"]),
+             "yes" if r["in_tables"] else "no"] for r in status["unfinished"]]
+    table = md_table(("unfinished run", "seed", "evaluations", "latest step", "of", "in the tables"), rows, 1) \
+        if rows else "No run is unfinished.\n"
+    return ("**Interim report** (`--partial`): unfinished runs are in the tables at their latest evaluation point, "
+            "so the numbers will change as they finish.\n\n" + table)
+
+
 def md_document(title: str, status: dict, body: str, protocol: str = PROTOCOL_TEXT) -> str:
+    if status.get("partial"):
+        return f"# {title} (interim)\n\n{interim_text(status)}\n{protocol}\n\n{status_text(status)}\n\n{body}"
     return f"# {title}\n\n{protocol}\n\n{status_text(status)}\n\n{body}"
 
 
 # ---- writing ----
 
 def write_tables(out_dir: str, suite_name: str, levels: dict, status: dict, protocol: str = PROTOCOL_TEXT,
-                 estimates: Optional[dict] = None) -> List[str]:
+                 estimates: Optional[dict] = None, score: str = "max") -> List[str]:
     """The CSV and Markdown files; returns their names. `protocol` is the paragraph that says what a value is
-    (kage.ppo.evaluate's differs: one checkpoint instead of maxima over training); `estimates`, the interval
-    estimates of kage.bench.intervals, where there are any."""
-    files = {"runs.csv": runs_csv(levels["runs"])}
+    (kage.ppo.evaluate's differs: one checkpoint instead of maxima over training) and `score` its name in
+    runs.csv; `estimates`, the interval estimates of kage.bench.intervals, where there are any. Under
+    status["partial"] every file is marked interim."""
+    files = {"runs.csv": runs_csv(levels["runs"], score)}
     combined = []
     if levels["pairs"]:
         files["axes.csv"] = axes_csv(levels["axes"])
@@ -171,6 +201,8 @@ def write_tables(out_dir: str, suite_name: str, levels: dict, status: dict, prot
         files["sweeps.md"] = md_document(f"{suite_name}: sweeps", status, md_sweeps(levels["sweeps"], 2), protocol)
         combined.append(f"## Sweeps\n\n{md_sweeps(levels['sweeps'], 3)}")
     files["report.md"] = md_document(f"{suite_name}: benchmark report", status, "\n".join(combined), protocol)
+    if status.get("partial"):
+        files = {name: mark_interim(text) if name.endswith(".csv") else text for name, text in files.items()}
     for name, text in files.items():
         atomic_write(os.path.join(out_dir, name), text.encode())
     return sorted(files)
