@@ -19,6 +19,7 @@
 
 #include "api/python/cuda_streams.h"
 #include "api/python/front_end.h"
+#include "api/python/paths.h"
 #include "kage/kage.h"
 
 namespace py = pybind11;
@@ -512,6 +513,7 @@ PYBIND11_MODULE(_kage, m) {
       "other error, chosen by the runtime's error kind.");
 
   m.def("gpu_backend_built", &kage::gpu_backend_built);
+  kage::python::register_paths(m);
   m.def("action_range_text", &kage::action_range_text, "The text in every error about an action outside 0..7.");
   m.def("resolve", [](const std::string& path, const std::string& asset_root) {
     return front_end_json(kage::python::resolve_config_json(path, asset_root));

@@ -10,6 +10,9 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
+
+#include "runtime/cuda/nvrtc_search.h"
 
 extern char** environ;
 
@@ -82,9 +85,29 @@ std::string find_host_cxx() {
   return "";
 }
 
+namespace {
+std::mutex& runtime_dir_mutex() {
+  static std::mutex m;
+  return m;
+}
+std::string& runtime_dir_set() {
+  static std::string d;
+  return d;
+}
+}  // namespace
+
+void set_runtime_include_dir(const std::string& dir) {
+  std::lock_guard<std::mutex> lock(runtime_dir_mutex());
+  runtime_dir_set() = dir;
+}
+
 std::string runtime_include_dir() {
   const std::string root = env("KAGE_ROOT");
   if (!root.empty()) return root;
+  {
+    std::lock_guard<std::mutex> lock(runtime_dir_mutex());
+    if (!runtime_dir_set().empty()) return runtime_dir_set();
+  }
   // An installed binary (kagec, or a library linked into a program) finds the headers that
   // `cmake --install` put beside it: <prefix>/bin/kagec -> <prefix>/share/kagec/runtime.
   // The binary is the running program, or the shared object this code was linked into.
@@ -154,10 +177,7 @@ std::string tool_version(const std::string& tool) {
 }
 
 std::string nvrtc_version() {
-  void* lib = nullptr;
-  for (const char* name : {"libnvrtc.so", "libnvrtc.so.13", "libnvrtc.so.12", "/usr/local/cuda/lib64/libnvrtc.so"}) {
-    if ((lib = ::dlopen(name, RTLD_NOW | RTLD_LOCAL))) break;
-  }
+  void* lib = open_nvrtc();
   if (!lib) return "";
   using VersionFn = int (*)(int*, int*);
   std::string v;

@@ -23,10 +23,13 @@ std::string join_flags(const std::vector<std::string>& flags);
 std::string find_nvcc();
 /// The host compiler: $KAGE_HOST_CXX, $CXX, then `c++` on PATH. Empty if none.
 std::string find_host_cxx();
-/// The directory the generated source's #include "runtime/..." resolve against: $KAGE_ROOT, else
-/// <prefix>/share/kagec beside an installed binary (<prefix>/bin or <prefix>/lib), else the source
-/// tree kagec was built from.
+/// The directory the generated source's #include "runtime/..." resolve against: $KAGE_ROOT, else the
+/// directory set by set_runtime_include_dir, else <prefix>/share/kagec beside an installed binary
+/// (<prefix>/bin or <prefix>/lib), else the source tree kagec was built from.
 std::string runtime_include_dir();
+/// Names the runtime headers' directory for a program that knows where they are installed: the
+/// Python package (its extension lives in site-packages, not beside <prefix>/share/kagec).
+void set_runtime_include_dir(const std::string& dir);
 
 /// First line of `tool --version` (empty if it cannot run).
 std::string tool_version(const std::string& tool);

@@ -22,6 +22,7 @@ _LAZY = {
     "make_vec": "kage.vector",
     "DeviceArray": "kage._native",
     "gpu_backend_built": "kage._native",
+    "__version__": "kage._version",  # written by CMake (python/CMakeLists.txt) from project(VERSION)
 }
 
 __all__ = sorted(_LAZY)

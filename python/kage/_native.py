@@ -20,5 +20,8 @@ def native() -> ModuleType:
 
         module.set_errors(errors.ConfigError, FileNotFoundError, errors.DeviceUnavailableError, ValueError,
                           RuntimeError)
+        from kage import resources  # pure Python: where the runtime headers and NVRTC are
+
+        resources.configure_native(module)
         _module = module
     return _module

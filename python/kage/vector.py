@@ -11,7 +11,7 @@ from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from kage import actions as _actions, front_end, spaces
+from kage import actions as _actions, front_end, resources, spaces
 from kage._native import native
 
 #: (name, numpy dtype, meaning) of every info field, in the runtime's order.
@@ -252,8 +252,7 @@ def make_vec(config: Union[str, os.PathLike], num_envs: int, device: str = "cpu"
         raise ValueError(f"device={device!r}: use 'cpu' or 'cuda'")
     if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs <= 0:
         raise ValueError(f"num_envs={num_envs!r}: a positive integer")
-    if not os.path.exists(config):
-        raise FileNotFoundError(f"config '{config}' not found (a YAML file or a kagec compile directory)")
+    config = resources.config_path(config)  # a path, or a shipped config's name; FileNotFoundError names near ones
     if threads is None:
         threads = min(int(num_envs), os.cpu_count() or 1)
     if threads <= 0:

@@ -9,6 +9,8 @@
 
 #include <mutex>
 
+#include "runtime/cuda/nvrtc_search.h"
+
 namespace {
 
 #define KAGE_STR2(x) #x
@@ -34,13 +36,7 @@ void* driver() {
 void* nvrtc() {
   static std::once_flag once;
   static void* handle = nullptr;
-  std::call_once(once, [] {
-    // The toolkit's default location too: it is often not on the loader's path.
-    static const char* const names[] = {"libnvrtc.so.13", "libnvrtc.so.12", "libnvrtc.so",
-                                        "/usr/local/cuda/lib64/libnvrtc.so.13", "/usr/local/cuda/lib64/libnvrtc.so.12",
-                                        nullptr};
-    handle = open_first(names);
-  });
+  std::call_once(once, [] { handle = kage::open_nvrtc(); });
   return handle;
 }
 

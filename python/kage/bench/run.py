@@ -35,7 +35,7 @@ import sys
 import time
 from typing import Dict, List, Optional
 
-from kage import front_end
+from kage import front_end, resources
 from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
 from kage.bench.units import Unit, select, units_of
@@ -254,7 +254,7 @@ class Bench:
 
 def add_bench_arguments(parser: argparse.ArgumentParser) -> None:
     """The arguments that choose a benchmark's runs (kage.bench run and slurm)."""
-    parser.add_argument("suite", help="a suite manifest (suites/*.yaml)")
+    parser.add_argument("suite", help="a suite manifest: a path, or a shipped suite's name (kage_bench)")
     parser.add_argument("--seeds", default="1-10", help="seeds: 1-10 (default), 1,3,5 or 7")
     parser.add_argument("--out", required=True, help="the benchmark directory (created, or continued)")
     parser.add_argument("--pairs", nargs="+", help="only these pairs or sweeps (by name)")
@@ -280,7 +280,7 @@ def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
               f"its runs train one at a time instead of {args.pack} at once", file=sys.stderr)
         args.pack = 1
     seeds = parse_seeds(args.seeds)
-    suite, out = os.path.abspath(args.suite), os.path.abspath(args.out)
+    suite, out = os.path.abspath(resources.suite_path(args.suite)), os.path.abspath(args.out)
     try:
         report = front_end.suite_report(suite)
     except ConfigError as e:

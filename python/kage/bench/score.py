@@ -11,7 +11,7 @@ import os
 import sys
 from typing import List, Optional
 
-from kage import front_end
+from kage import front_end, resources
 from kage.bench import report, tables
 from kage.bench.units import select, units_of
 from kage.errors import ConfigError
@@ -30,7 +30,7 @@ def score_suite(agent, spec: dict, file: str, state: dict, options) -> dict:
     """Every chosen pair or sweep evaluated like a training run's evaluation point, then the report's three
     levels (kage.bench.report.aggregate) over these single evaluations."""
     try:
-        suite = front_end.suite_report(options.suite)
+        suite = front_end.suite_report(resources.suite_path(options.suite))
     except ConfigError as e:
         fail(f"{e}\nkage.bench score: fix the suite first")
     units = select(units_of(suite), options.pairs, "kage.bench score")
@@ -54,7 +54,8 @@ def score_suite(agent, spec: dict, file: str, state: dict, options) -> dict:
 def main(argv: Optional[List[str]] = None) -> int:
     parser = argparse.ArgumentParser(prog="python3 -m kage.bench score", description=__doc__.split("\n\n")[0])
     add_scoring_arguments(parser)
-    parser.add_argument("--suite", required=True, help="a suite manifest: both sides of each pair")
+    parser.add_argument("--suite", required=True,
+                        help="a suite manifest (a path, or a shipped suite's name): both sides of each pair")
     parser.add_argument("--pairs", nargs="+", help="only these pairs or sweeps")
     parser.add_argument("--out", required=True, help="where to write the tables (created)")
     options = parser.parse_args(argv)

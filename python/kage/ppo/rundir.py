@@ -26,7 +26,7 @@ from typing import Dict, List, Optional, Tuple
 
 import torch
 
-from kage import front_end
+from kage import front_end, resources
 from kage.ppo import plugins
 from kage.util.files import atomic_write, safe, write_json
 
@@ -36,10 +36,14 @@ _ADDED_ARGUMENTS = {"agent": "kage.ppo.agent:nature_cnn", "augment": None, "vide
 
 
 def code_version() -> str:
-    """The git commit of the sources this package was built from, with "+dirty" for local changes."""
-    from kage import _build_info
+    """The git commit of the sources this package was built from, with "+dirty" for local changes: read
+    now from a build tree's checkout, or as an installed package's build recorded it."""
+    root = resources.source_root()
+    if root is None:
+        from kage import _version  # written by CMake at the build's configure step
+
+        return _version.commit
     try:
-        root = _build_info.source_root
         commit = subprocess.run(["git", "-C", root, "rev-parse", "HEAD"], capture_output=True, text=True, check=True)
         dirty = subprocess.run(["git", "-C", root, "status", "--porcelain", "--untracked-files=no"],
                                capture_output=True, text=True, check=True)

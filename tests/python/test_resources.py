@@ -1,0 +1,78 @@
+"""kage.resources: shipped configs and suites by name, the data root of a build tree, and where the
+extension looks for NVRTC (the nvidia-cuda-nvrtc wheel of scripts/constraints.txt first)."""
+import importlib.metadata
+import os
+import pathlib
+
+import pytest
+
+from kage import _native, resources
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+
+
+def test_a_build_tree_package_reads_its_source_tree():
+    assert resources.source_root() == REPO
+    assert resources.data_root() == REPO
+    assert resources.runtime_include_dir() == str(REPO)
+
+
+def test_shipped_configs_and_suites_by_name():
+    assert resources.config_path("throughput/simplest") == str(REPO / "configs/throughput/simplest.yaml")
+    assert resources.config_path("kage_bench/bases/shape_black.yaml") == str(
+        REPO / "configs/kage_bench/bases/shape_black.yaml")
+    assert resources.config_path("configs/throughput/hardest") == str(REPO / "configs/throughput/hardest.yaml")
+    assert resources.suite_path("kage_bench") == str(REPO / "suites/kage_bench.yaml")
+
+
+def test_an_existing_path_is_taken_as_it_is(tmp_path):
+    config = tmp_path / "mine.yaml"
+    config.write_text("extends: whatever\n")
+    assert resources.config_path(str(config)) == str(config)
+    assert resources.config_path(str(tmp_path)) == str(tmp_path)  # a kagec compile folder
+
+
+def test_an_unknown_name_lists_near_ones():
+    with pytest.raises(FileNotFoundError) as e:
+        resources.config_path("throughput/simplst")
+    assert "'throughput/simplst' is neither a path nor a shipped config name" in str(e.value)
+    assert "near names: throughput/simplest" in str(e.value)
+    with pytest.raises(FileNotFoundError, match="near names: kage_bench"):
+        resources.suite_path("kage_bnch")
+
+
+def test_make_vec_takes_a_shipped_name():
+    import kage
+
+    env = kage.make_vec("throughput/simplest", 2)
+    env.reset(seed=0)
+    assert env.config == str(REPO / "configs/throughput/simplest.yaml")
+
+
+def test_the_nvrtc_wheel_is_searched_first(monkeypatch):
+    wheel = importlib.metadata.distribution("nvidia-cuda-nvrtc")  # pinned in scripts/constraints.txt
+    lib = [f for f in wheel.files if f.name == "libnvrtc.so.13"]
+    assert len(lib) == 1
+    wheel_dir = str(pathlib.Path(wheel.locate_file(lib[0])).parent)
+    assert resources.nvrtc_dirs() == [wheel_dir]
+
+    native = _native.native()  # its first load named the wheel's folder
+    monkeypatch.setenv("CUDA_HOME", "/opt/cuda-home")
+    monkeypatch.delenv("CUDA_PATH", raising=False)
+    names = ["libnvrtc.so.13", "libnvrtc.so.12", "libnvrtc.so"]
+    assert native.nvrtc_candidates() == (
+        [f"{wheel_dir}/{n}" for n in names] + [f"/opt/cuda-home/lib64/{n}" for n in names] + names
+        + [f"/usr/local/cuda/lib64/{n}" for n in names])
+    native.set_nvrtc_dirs(["/a", "/b"])
+    try:
+        assert native.nvrtc_candidates()[:6] == [f"/a/{n}" for n in names] + [f"/b/{n}" for n in names]
+    finally:
+        native.set_nvrtc_dirs(resources.nvrtc_dirs())
+
+
+def test_the_version_is_the_projects():
+    import kage
+
+    cmake = (REPO / "CMakeLists.txt").read_text()
+    assert f"project(kagec VERSION {kage.__version__} " in cmake
+    assert os.path.isfile(REPO / "CHANGELOG.md") and f"## {kage.__version__}" in (REPO / "CHANGELOG.md").read_text()
