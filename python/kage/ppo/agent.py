@@ -121,7 +121,7 @@ class Agent(nn.Module):
         """The three convolutions on kage.ppo.fast.triton_conv's kernels (--triton-conv): the runs as a batch index
         instead of channel groups, activations [K, B, H, W, C], the same parameters; conv1 on the frames cut
         into 4x4 blocks as under --fused-input. Returns [K, B, flat] in each run's (channel, row, column) order."""
-        from kage import triton_conv  # here, not at the top: triton is needed only under the flag
+        from kage.ppo.fast import triton_conv  # here, not at the top: triton is needed only under the flag
         k, b = obs.shape[:2]
         x = space_to_depth(obs, 4, self.input_dtype).div_(255.0)
         x = F.relu(triton_conv.packed_conv(x, weight_space_to_depth(self.conv1.weight, 4), self.conv1.bias))
