@@ -1,0 +1,140 @@
+"""kage.ppo.fast.triton_conv's kernels (--triton-conv) on the CPU under Triton's interpreter, in float32, against
+torch's grouped convolutions (F.conv2d(groups=K), the plain layers) on the same values: the output and the input,
+weight and bias gradients of the NatureCNN's three layers as the trainer runs them (conv1 as the 2x2 stride-1
+convolution of 4x4 blocks, 48 channels; conv2 as the 2x2 one of 2x2 blocks, 128 channels; conv3 3x3), under each
+autotuning config of every kernel, K = 2 runs of B = 2 or 3 frames; the weight gradient's split into partial
+sums; and the Agent's --triton-conv torso against its plain one, forward and parameter gradients.
+
+The interpreter computes tl.dot in full float32 (no TF32), so the kernels must agree with torch to float32
+rounding. bfloat16 is checked on the GPU only (tests/gpu/test_triton_conv.py): the interpreter does not emulate
+bf16 tl.dot. A missing triton fails this file: CI installs it (scripts/constraints.txt).
+
+TRITON_INTERPRET is read when triton.jit decorates a kernel, so this module sets it before importing triton or
+kage.ppo.fast.triton_conv; CTest runs each test file in its own process. In a pytest process that imported
+triton_conv earlier without it, the tests fail with a message saying so.
+"""
+import os
+
+os.environ["TRITON_INTERPRET"] = "1"
+
+import pytest  # noqa: E402
+import torch  # noqa: E402
+import torch.nn.functional as F  # noqa: E402
+from triton.runtime.interpreter import InterpretedFunction  # noqa: E402
+
+from kage.ppo.agent import Agent  # noqa: E402
+from kage.ppo.fast import triton_conv as tc  # noqa: E402
+from kage.ppo.fast.space_to_depth import space_to_depth, weight_space_to_depth  # noqa: E402
+
+KERNELS = (tc.forward_kernel, tc.dgrad_kernel, tc.wgrad_kernel)
+# NatureCNN's convolutions on 128 x 128 x 3 frames: (name, input side, in channels, out channels, kernel, stride).
+LAYERS = [("conv1", 128, 3, 32, 8, 4), ("conv2", 31, 32, 64, 4, 2), ("conv3", 14, 64, 64, 3, 1)]
+# max |got - want| / max |want|: float32 rounding of sums over up to 1,024 products, in another order.
+TOLERANCE = 1e-5
+
+
+@pytest.fixture(autouse=True)
+def interpreted():
+    if not all(isinstance(kernel.fn, InterpretedFunction) for kernel in KERNELS):
+        pytest.fail("kage.ppo.fast.triton_conv was imported before TRITON_INTERPRET=1 was set: run this file in "
+                    "its own pytest process (as CTest does)")
+
+
+@pytest.fixture(params=range(4), ids=lambda i: f"config{i}")
+def one_config(request, monkeypatch):
+    """Each kernel restricted to its request.param-th autotuning config: with one config the autotuner runs it
+    without benchmarking (which needs a GPU driver), and each config's tile sizes meet the masks differently."""
+    for kernel in KERNELS:
+        monkeypatch.setattr(kernel, "configs", [kernel.configs[request.param]])
+    return request.param
+
+
+def relative_error(got: torch.Tensor, want: torch.Tensor) -> float:
+    assert got.shape == want.shape, (got.shape, want.shape)
+    return ((got.double() - want.double()).abs().max() / want.double().abs().max()).item()
+
+
+def packed_layer(name: str, x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int) -> torch.Tensor:
+    """One layer as Agent._torso_triton runs it: conv1 on the frames' 4x4 blocks, conv2 through packed_conv's
+    2x2 blocks, conv3 as it is."""
+    if name == "conv1":
+        return tc.packed_conv(space_to_depth(x, 4), weight_space_to_depth(weight, 4), bias)
+    return tc.packed_conv(x, weight, bias, stride)
+
+
+def grouped_layer(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int) -> torch.Tensor:
+    """The plain layer: x [K, B, H, W, C] as K channel groups of [B, K * C, H, W] through F.conv2d(groups=K),
+    the result back as [K, B, OH, OW, Cout]."""
+    k, b, h, w, c = x.shape
+    y = F.conv2d(x.permute(1, 0, 4, 2, 3).reshape(b, k * c, h, w), weight, bias, stride=stride, groups=k)
+    return y.reshape(b, k, -1, *y.shape[2:]).permute(1, 0, 3, 4, 2)
+
+
+@pytest.mark.parametrize("layer", LAYERS, ids=[layer[0] for layer in LAYERS])
+def test_layer_equals_grouped_conv(layer, one_config):
+    name, side, cin, cout, ksize, stride = layer
+    # K != B once: an index that mixes the two up reads other frames (the formulas are the same under every
+    # config); B = 2 under the others, to keep the interpreter's time down.
+    k, b = 2, 3 if one_config == 0 else 2
+    generator = torch.Generator().manual_seed(one_config)
+    x = torch.randn(k, b, side, side, cin, generator=generator, requires_grad=True)
+    weight = torch.randn(k * cout, cin, ksize, ksize, generator=generator, requires_grad=True)
+    bias = torch.randn(k * cout, generator=generator, requires_grad=True)
+
+    y = packed_layer(name, x, weight, bias, stride)
+    dy = torch.randn(y.shape, generator=generator)
+    got = (y,) + torch.autograd.grad(y, (x, weight, bias), dy)
+    y_ref = grouped_layer(x, weight, bias, stride)
+    want = (y_ref,) + torch.autograd.grad(y_ref, (x, weight, bias), dy)
+
+    for quantity, g, w in zip(("y", "dx", "dw", "db"), got, want):
+        assert g.dtype == torch.float32, quantity
+        assert relative_error(g, w) <= TOLERANCE, (name, quantity, relative_error(g, w))
+
+
+@pytest.mark.parametrize("chunk", [100, 128])
+def test_weight_gradient_partial_sums(chunk, monkeypatch):
+    """On the GPU, M's rows split into parts of at least 2,048 rows; here conv3's 288 rows of K = 2 runs of
+    B = 2 split into 3 parts, the last one short (and a chunk that is no multiple of BLOCK_M: rows masked
+    within a part), and the parts' sums must add up to the whole gradient."""
+    monkeypatch.setattr(tc, "_wgrad_chunk", lambda m, runs: chunk)
+    for kernel in KERNELS:
+        monkeypatch.setattr(kernel, "configs", kernel.configs[:1])
+    k, b, side, cin, cout, ksize = 2, 2, 14, 64, 64, 3
+    generator = torch.Generator().manual_seed(chunk)
+    x = torch.randn(k, b, side, side, cin, generator=generator)
+    weight = torch.randn(k * cout, cin, ksize, ksize, generator=generator, requires_grad=True)
+    out = side - ksize + 1
+    dy = torch.randn(k, b, out, out, cout, generator=generator)
+    (dw_ref,) = torch.autograd.grad(grouped_layer(x, weight, None, 1), weight, dy)
+
+    dw = tc._wgrad(x, dy, ksize, ksize)  # [K, kh, kw, Cin, Cout]
+    assert relative_error(dw, dw_ref.reshape(k, cout, cin, ksize, ksize).permute(0, 3, 4, 2, 1)) <= TOLERANCE
+
+
+def test_agent_triton_torso_equals_plain(monkeypatch):
+    """The whole network with --fused-input --triton-conv against the default (cuDNN's path on the GPU, here
+    torch's CPU convolutions): the same parameters give the same logits, values and parameter gradients. This
+    checks the torso's wiring (blocks, scaling, each run's flatten order), on 64 x 64 frames to keep the
+    interpreter's time down: the layer test covers the 128 x 128 frames' shapes and the other configs."""
+    for kernel in KERNELS:
+        monkeypatch.setattr(kernel, "configs", kernel.configs[:1])
+    seeds, frames, side = [3, 4], 3, 64
+    plain = Agent(seeds, height=side, width=side)
+    fast = Agent(seeds, height=side, width=side, fused_input=True, triton_conv=True)
+    for (name, p), q in zip(plain.named_parameters(), fast.parameters()):
+        assert torch.equal(p, q), f"{name}: the two agents must start from the same parameters"
+    generator = torch.Generator().manual_seed(0)
+    obs = torch.randint(0, 256, (len(seeds), frames, side, side, 3), dtype=torch.uint8, generator=generator)
+    weights = torch.randn(len(seeds), frames, 8, generator=generator)
+
+    results = []
+    for agent in (plain, fast):
+        logits, value = agent(obs)
+        loss = (logits * weights).sum() + value.square().sum()  # every output reaches the gradients
+        results.append((logits, value, torch.autograd.grad(loss, list(agent.parameters()))))
+    (logits, value, grads), (fast_logits, fast_value, fast_grads) = results
+    assert relative_error(fast_logits, logits) <= TOLERANCE
+    assert relative_error(fast_value, value) <= TOLERANCE
+    for (name, _), g, fast_g in zip(plain.named_parameters(), grads, fast_grads):
+        assert relative_error(fast_g, g) <= TOLERANCE, (name, relative_error(fast_g, g))
