@@ -137,6 +137,9 @@ def main() -> None:
     other = wall - sum(phases[phase] for phase in PHASES)
     print(f"| other (host, logging, gaps) | {other:.3f} | {100 * other / wall:.1f} % | | "
           f"{(kernel_total - sum(attributed.values())) / 1e6:.3f} (outside the phases) | |")
+    for phase in PHASES:  # the profiler attaches after --cuda-graph's capture: say so if a graph's kernels were lost
+        if phases[phase] > 0 and not attributed.get(phase):
+            print(f"note: no kernel was linked to phase {phase} (its kernels count under 'outside the phases')")
 
     print_kernels("Top kernels of the profiled iteration, all phases", overall, kernel_total, a.top)
     for phase in PHASES:
