@@ -1,4 +1,4 @@
-"""python3 -m kage.bench {run,slurm,status,report,score,speed} ...: the benchmark's command line."""
+"""python3 -m kage.bench {run,slurm,status,report,compare,score,speed} ...: the benchmark's command line."""
 import argparse
 import sys
 from typing import List, Optional
@@ -7,12 +7,14 @@ from typing import List, Optional
 def main(argv: Optional[List[str]] = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     parser = argparse.ArgumentParser(prog="python3 -m kage.bench", description=__doc__)
-    commands = parser.add_subparsers(dest="command", required=True, metavar="{run,slurm,status,report,score,speed}")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="{run,slurm,status,report,compare,score,speed}")
     commands.add_parser("run", help="train every (pair, seed) of a suite; trainer flags pass through",
                         add_help=False)
     commands.add_parser("slurm", help="write (or submit) a Slurm job array over the suite's runs", add_help=False)
     commands.add_parser("speed", help="training steps/s of K packed runs and where the time goes", add_help=False)
     commands.add_parser("score", help="evaluate a checkpoint on both sides of a suite's pairs", add_help=False)
+    commands.add_parser("compare", help="two or more benchmark directories of one suite side by side, with intervals",
+                        add_help=False)
     status = commands.add_parser("status", help="runs done, running and failed in a benchmark directory")
     status.add_argument("dir", help="a directory written by `python3 -m kage.bench run` or `slurm`")
     report = commands.add_parser("report", help="write the tables and plots of a benchmark directory")
@@ -32,6 +34,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     if argv[:1] == ["score"]:
         from kage.bench import score
         return score.main(argv[1:])
+    if argv[:1] == ["compare"]:
+        from kage.bench import compare
+        return compare.main(argv[1:])
     if argv[:1] == ["speed"]:
         from kage.bench import speed
         return speed.main(argv[1:])

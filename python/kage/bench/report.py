@@ -447,6 +447,16 @@ def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], lev
 
 # ---- the command ----
 
+def read_benchmark(bench_dir: str) -> Tuple[dict, dict, List[Unit], Dict[str, List[Run]]]:
+    """suite.json, bench.json, the units that were run (bench.json's "units": what `run --pairs` chose, when it
+    chose) and their runs by unit name."""
+    suite = load_suite(bench_dir)
+    bench = read_bench(bench_dir)
+    selected = bench.get("units")
+    units = [u for u in units_of(suite, bench.get("shared")) if selected is None or u.name in selected]
+    return suite, bench, units, {unit.name: find_runs(bench_dir, unit) for unit in units}
+
+
 def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
            reps: int = intervals.REPS, partial: bool = False) -> dict:
     """Reads the benchmark directory `bench_dir`, writes the tables, plots and report.json into `out_dir`
@@ -454,13 +464,9 @@ def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
     and returns report.json's content. `reps`: bootstrap resamples of the interval estimates."""
     if protocol not in PROTOCOLS:
         fail(f"unknown protocol '{protocol}': choose {' or '.join(PROTOCOLS)}")
-    suite = load_suite(bench_dir)
-    bench = read_bench(bench_dir)
+    suite, bench, units, runs = read_benchmark(bench_dir)
     out_dir = out_dir or os.path.join(bench_dir, ("report" if protocol == "max" else "report_final")
                                       + ("_interim" if partial else ""))
-    selected = bench.get("units")  # what `run --pairs` chose, when it chose
-    units = [u for u in units_of(suite, bench.get("shared")) if selected is None or u.name in selected]
-    runs = {unit.name: find_runs(bench_dir, unit) for unit in units}
     levels = aggregate(units, runs, protocol, partial)
     status = run_status(units, runs, [s for s in bench.get("seeds", []) if isinstance(s, int)], partial)
     result = {
