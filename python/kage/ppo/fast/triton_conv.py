@@ -3,8 +3,9 @@ grid axis instead of a channel group, so each layer and pass is one launch over 
 are never materialised (cuDNN runs grouped convolutions group by group with slicing copies; im2col + bmm
 moved more bytes than it saved: bench/results/2026-11-23-h100-packed-training-speed.md). Activations are
 [K, B, H, W, C] (NHWC per run); the parameters keep nn.Conv2d(groups=K)'s layout, so checkpoints are the
-same. Imported only under --triton-conv: triton is a GPU-machine dependency. Checked and timed by
-tests/gpu/test_triton_conv.py.
+same. Imported only under --triton-conv: triton is a GPU-machine dependency (and the CI tests'). Checked and
+timed on the GPU by tests/gpu/test_triton_conv.py, and in float32 on the CPU under Triton's interpreter by
+tests/python/test_triton_interpreter.py.
 """
 import torch
 import triton
