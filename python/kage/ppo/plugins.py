@@ -23,6 +23,8 @@ from typing import Callable, List, Optional, Sequence
 import torch
 import torch.nn as nn
 
+from kage.ppo.policy import autocast
+
 BASELINE_AGENT = "kage.ppo.agent:nature_cnn"
 # Modules of the package that moved: references written before (command lines, run.json) still name them.
 MOVED_MODULES = {"kage.agent": "kage.ppo.agent", "kage.augment": "kage.ppo.augment"}
@@ -98,7 +100,7 @@ def build_agent(reference: str, observation_shape: Sequence[int], num_actions: i
     agent = net if packable else LoneRun(net)
     K = len(seeds)
     blank = torch.zeros((K, 2, *observation_shape), dtype=torch.uint8, device=device)
-    with torch.no_grad():
+    with torch.no_grad(), autocast(bool(speed and speed.get("bf16"))):  # as the trainer calls it
         logits, value = agent(blank)
     if tuple(logits.shape) != (K, 2, num_actions) or tuple(value.shape) != (K, 2):
         shape = "[K, B, H, W, C] -> [K, B, A], [K, B]" if packable else "[B, H, W, C] -> [B, A], [B]"
