@@ -19,7 +19,6 @@ from typing import List, Optional
 import torch
 
 import kage
-from kage import _kage
 from kage.ppo import plugins, rundir, video
 from kage.errors import ConfigError
 from kage.util import tables
