@@ -10,6 +10,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "api/environment.h"
 #include "compiler/codegen/codegen.h"
 #include "compiler/codegen/compiled_dir.h"
 #include "compiler/lower/load_lowered.h"
@@ -86,6 +87,18 @@ bool checked_host_actions(const Actions& a, int32_t n, std::vector<int32_t>* out
   return problem.empty() || fail(error, "kage: " + problem);
 }
 
+/// Before its first reset (or load_state) a batch holds no episode: a step, or a reset that leaves some
+/// environments out, would run an all-zero state. The reason to refuse, or empty.
+std::string unstarted_problem(bool started, bool stepping, const uint8_t* mask, int32_t n) {
+  if (started) return {};
+  if (stepping) return "kage: step before reset: reset the batch (or load a saved state) first";
+  for (int32_t i = 0; mask && i < n; ++i)
+    if (!mask[i])
+      return "kage: the first reset must reset every environment (environment " + std::to_string(i) +
+             " is masked out and has never been reset): reset without a mask first";
+  return {};
+}
+
 /// A lowered config with its Spec hash, from a YAML file or a compiled dir's params.bin.
 struct Loaded {
   std::string spec_hash;
@@ -121,11 +134,18 @@ class HostEnv final : public Env {
   ~HostEnv() override {
     if (lib_) ::dlclose(lib_);
   }
-  bool reset(const uint64_t* seeds, const uint8_t* mask, std::string*) override {
+  bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* e) override {
+    last_error_kind_ = ErrorKind::kUsage;
+    const std::string problem = unstarted_problem(started_, false, mask, batch_.size());
+    if (!problem.empty()) return fail(e, problem);
     last_error_kind_ = ErrorKind::kNone;
+    started_ = true;
     return batch_.reset(seeds, mask), true;
   }
   bool step(const Actions& a, std::string* e) override {
+    last_error_kind_ = ErrorKind::kUsage;
+    const std::string problem = unstarted_problem(started_, true, nullptr, batch_.size());
+    if (!problem.empty()) return fail(e, problem);
     last_error_kind_ = ErrorKind::kOther;
     if (a.memory != Memory::kHost) return fail(e, "kage: device actions given to a CPU environment: pass host memory");
     if (!checked_host_actions(a, batch_.size(), &actions_, &last_error_kind_, e)) return false;
@@ -158,10 +178,12 @@ class HostEnv final : public Env {
   }
   bool load_state(const uint8_t* data, size_t size, std::string* e) override {
     const std::string problem = batch_.load_state(data, size, hash_);
-    return problem.empty() || fail(e, "kage: load_state: " + problem);
+    if (!problem.empty()) return fail(e, "kage: load_state: " + problem);
+    return started_ = true;
   }
 
  private:
+  bool started_ = false;  // a reset or load_state has run
   void* lib_;
   AssetPack pack_;
   HostBatch batch_;
@@ -215,10 +237,16 @@ class GpuEnv final : public Env {
     if (cuCtxSetCurrent(ctx_) == CUDA_SUCCESS) cuCtxSynchronize();
   }
   bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* e) override {
+    last_error_kind_ = ErrorKind::kUsage;
+    const std::string problem = unstarted_problem(started_, false, mask, batch_.size());
+    if (!problem.empty()) return fail(e, problem);
     last_error_kind_ = ErrorKind::kOther;
-    return bind(e) && no_pending_error(e) && batch_.reset(seeds, mask, e) && succeeded();
+    return bind(e) && no_pending_error(e) && batch_.reset(seeds, mask, e) && (started_ = true) && succeeded();
   }
   bool step(const Actions& a, std::string* e) override {
+    last_error_kind_ = ErrorKind::kUsage;
+    const std::string problem = unstarted_problem(started_, true, nullptr, batch_.size());
+    if (!problem.empty()) return fail(e, problem);
     last_error_kind_ = ErrorKind::kOther;
     if (!bind(e) || !no_pending_error(e)) return false;
     if (a.memory == Memory::kDevice) {
@@ -260,7 +288,8 @@ class GpuEnv final : public Env {
     return bind(e) && batch_.save_state(hash_, out, e);
   }
   bool load_state(const uint8_t* data, size_t size, std::string* e) override {
-    return bind(e) && (batch_.load_state(data, size, hash_, e) || fail(e, "kage: load_state: " + *e));
+    return bind(e) && (batch_.load_state(data, size, hash_, e) || fail(e, "kage: load_state: " + *e)) &&
+           (started_ = true);
   }
 
  private:
@@ -281,6 +310,7 @@ class GpuEnv final : public Env {
     return true;
   }
 
+  bool started_ = false;  // a reset or load_state has run
   CUcontext ctx_;
   CudaModule module_;
   AssetPack pack_;
@@ -312,6 +342,20 @@ std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const 
 }
 #endif
 
+/// Refuses a CPU batch that would need more than half of the machine's memory, before allocating it (as
+/// kagec's commands do): it would fail or swap.
+bool fits_in_memory(const LatentParams& latent, const VisualParams& visual, const Options& o, std::string* error) {
+  LoweredConfig config;
+  config.latent = latent;
+  config.visual = visual;
+  const uint64_t need = batch_bytes_estimate(config, o.num_envs, o.num_threads), have = physical_memory_bytes();
+  if (!have || need <= have / 2) return true;
+  return fail(error, "kage::open: " + std::to_string(o.num_envs) + " environments of " + std::to_string(visual.H) +
+                         "x" + std::to_string(visual.W) + " observations need " + gib_text(need) +
+                         ", more than half of this machine's " + gib_text(have) +
+                         ": use fewer environments or smaller observations");
+}
+
 /// open() without the final error kind: sets *kind where a failure has a specific one.
 std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::string* error, ErrorKind* kind) {
   if (o.num_envs <= 0 || o.num_threads <= 0)
@@ -330,6 +374,10 @@ std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::st
       if (!c->has(kHostLibraryFile))
         return fail(error, "kage::open: '" + path + "' has no kernels_host.so (compile without --no-host/--no-build)"),
                nullptr;
+      LoweredConfig params;
+      if (!read_compiled_params(*c, &params.latent, &params.visual, &problem))
+        return fail(error, "kage::open: '" + path + "': " + problem), nullptr;
+      if (!fits_in_memory(params.latent, params.visual, o, error)) return *kind = ErrorKind::kUsage, nullptr;
       return open_compiled_cpu(*c, o, error);
     }
     *kind = ErrorKind::kOther;
@@ -346,6 +394,8 @@ std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::st
   }
   std::optional<Loaded> l = load_yaml(path, o, error);
   if (!l) return *kind = ErrorKind::kConfig, nullptr;
+  if (o.backend == Backend::kCpu && !fits_in_memory(l->config.latent, l->config.visual, o, error))
+    return *kind = ErrorKind::kUsage, nullptr;
   AssetPackResult assets = load_asset_pack(l->config.assets);
   if (!assets.ok()) return fail(error, "kage::open: " + assets.error), nullptr;
   if (o.backend == Backend::kCpu)

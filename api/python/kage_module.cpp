@@ -37,6 +37,15 @@ ErrorClasses& error_classes() {
 
 void raise_value_error(const std::string& message) { throw py::value_error(message); }
 
+/// Text from the runtime or the front end as a Python str. A config need not be UTF-8, and its lines are
+/// quoted in diagnostics: undecodable bytes become U+FFFD instead of a UnicodeDecodeError that would hide
+/// the located message.
+py::str text(const std::string& s) {
+  PyObject* decoded = PyUnicode_DecodeUTF8(s.data(), static_cast<Py_ssize_t>(s.size()), "replace");
+  if (!decoded) throw py::error_already_set();
+  return py::reinterpret_steal<py::str>(decoded);
+}
+
 /// Each kage::DType (in its enum order) as DLPack, __array_interface__ and byte size see it.
 struct DTypeFacts {
   DLDataType dl;
@@ -435,7 +444,7 @@ class PyEnv {
     if (o.ok) return;
     const ErrorClasses& e = error_classes();
     const py::object& cls = o.kind == kage::ErrorKind::kAction ? e.usage : e.other;
-    PyErr_SetObject(cls.ptr(), py::str(o.error).ptr());
+    PyErr_SetObject(cls.ptr(), text(o.error).ptr());
     throw py::error_already_set();
   }
 
@@ -476,14 +485,14 @@ PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& dev
                           : kind == kage::ErrorKind::kDevice ? e.device
                           : kind == kage::ErrorKind::kUsage  ? e.usage
                                                              : e.other;
-  PyErr_SetObject(cls.ptr(), py::str(error).ptr());
+  PyErr_SetObject(cls.ptr(), text(error).ptr());
   throw py::error_already_set();
 }
 
 /// The JSON of a front-end call, or its diagnostics raised as the config error class.
-std::string front_end_json(const kage::python::FrontEndResult& r) {
-  if (r.ok()) return r.json;
-  PyErr_SetObject(error_classes().config.ptr(), py::str(r.error).ptr());
+py::str front_end_json(const kage::python::FrontEndResult& r) {
+  if (r.ok()) return text(r.json);
+  PyErr_SetObject(error_classes().config.ptr(), text(r.error).ptr());
   throw py::error_already_set();
 }
 

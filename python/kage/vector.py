@@ -26,12 +26,45 @@ def env_seeds(seed: int, num_envs: int) -> np.ndarray:
     return np.random.SeedSequence(seed).generate_state(num_envs, dtype=np.uint64)
 
 
+MAX_INT32 = 2**31 - 1  # the runtime's environment and thread counts are int32
+
+
+def _is_integer(value) -> bool:
+    """An int or numpy integer (a 0-d integer array too), not a bool: values that floats or strings would
+    only approximate are refused, never truncated."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def _seed_value(seed, what: str = "seed") -> int:
+    """A seed as a Python int: a non-negative integer, anything else refused (1.5 is not seed 1)."""
+    if not _is_integer(seed) or int(seed) < 0:
+        raise ValueError(f"{what}={seed!r:.80}: a non-negative integer")
+    return int(seed)
+
+
 def _explicit_seeds(seed, num_envs: int) -> np.ndarray:
     """num_envs integers in [0, 2^64) as uint64 (Python ints above 2^63 would become float64 in numpy)."""
     values = list(seed)
-    if len(values) != num_envs or not all(isinstance(v, (int, np.integer)) and 0 <= int(v) < 2**64 for v in values):
+    if len(values) != num_envs or not all(_is_integer(v) and 0 <= int(v) < 2**64 for v in values):
         raise ValueError(f"seed: an int or {num_envs} non-negative ints below 2**64, got {seed!r:.80}")
     return np.array([int(v) for v in values], dtype=np.uint64)
+
+
+def _reset_mask(value, num_envs: int) -> np.ndarray:
+    """options["reset_mask"] as uint8 0/1: booleans, or integers that are all 0 or 1; floats (0.5, NaN) and
+    other integers (256 would wrap to 0) are refused rather than cast."""
+    mask = np.asarray(value)
+    if mask.shape != (num_envs,):
+        raise ValueError(f"options['reset_mask']: expected {num_envs} booleans, got shape {mask.shape}")
+    if mask.dtype.kind in "iu":
+        bad = sorted(set(mask[(mask != 0) & (mask != 1)].tolist()))
+        if bad:
+            raise ValueError(f"options['reset_mask']: booleans or 0/1, got {', '.join(map(str, bad[:5]))}")
+    elif mask.dtype.kind != "b":
+        raise ValueError(f"options['reset_mask']: booleans or 0/1 integers, got dtype {mask.dtype}")
+    return mask.astype(np.uint8)
 
 
 def _state_bytes(state) -> Any:
@@ -120,16 +153,13 @@ class VecEnv:
                 self.num_envs, dtype=np.uint64) if self._resets_without_seed else env_seeds(self._seed, self.num_envs)
             self._resets_without_seed += 1
         elif np.ndim(seed) == 0:
-            seeds = env_seeds(int(seed), self.num_envs)
+            seeds = env_seeds(_seed_value(seed), self.num_envs)
         else:
             seeds = _explicit_seeds(seed, self.num_envs)
         mask = None
         options = dict(options or {})
         if "reset_mask" in options:
-            mask = np.asarray(options.pop("reset_mask"))
-            if mask.shape != (self.num_envs,):
-                raise ValueError(f"options['reset_mask']: expected {self.num_envs} booleans, got shape {mask.shape}")
-            mask = mask.astype(np.uint8)
+            mask = _reset_mask(options.pop("reset_mask"), self.num_envs)
         if options:
             raise ValueError(f"reset: unknown options {sorted(options)} (known: 'reset_mask')")
         handle.reset(seeds, mask)
@@ -245,20 +275,25 @@ def make_vec(config: Union[str, os.PathLike], num_envs: int, device: str = "cpu"
 
     Raises ``kage.ConfigError`` (with kagec's located diagnostics) for a config with errors,
     ``FileNotFoundError`` for a missing config, ``RuntimeError`` for ``device="cuda"`` without a usable
-    GPU, ``ValueError`` for bad arguments.
+    GPU, ``ValueError`` for bad arguments and for a CPU batch that would need more than half of the
+    machine's memory. The batch holds no episode until the first ``reset()`` (or ``load_state``): a step
+    before it raises ``RuntimeError``.
     """
     config = os.fspath(config)
     if device not in ("cpu", "cuda"):
         raise ValueError(f"device={device!r}: use 'cpu' or 'cuda'")
-    if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs <= 0:
-        raise ValueError(f"num_envs={num_envs!r}: a positive integer")
+    if not _is_integer(num_envs) or not 0 < num_envs <= MAX_INT32:
+        raise ValueError(f"num_envs={num_envs!r}: a positive integer up to {MAX_INT32}")
+    seed = _seed_value(seed)
     config = resources.config_path(config)  # a path, or a shipped config's name; FileNotFoundError names near ones
     if threads is None:
         threads = min(int(num_envs), os.cpu_count() or 1)
-    if threads <= 0:
-        raise ValueError(f"threads={threads}: a positive integer")
+    if not _is_integer(threads) or not 0 < threads <= MAX_INT32:
+        raise ValueError(f"threads={threads!r}: a positive integer up to {MAX_INT32}")
     if device == "cpu" and stream is not None:
         raise ValueError("stream= is for device='cuda'")
-    stream_handle = 0 if stream is None else int(getattr(stream, "cuda_stream", stream))
-    handle = native().open(config, int(num_envs), device, int(threads), asset_root or "", stream_handle)
-    return VecEnv(handle, config, int(seed), asset_root)
+    stream_handle = 0 if stream is None else getattr(stream, "cuda_stream", stream)
+    if not _is_integer(stream_handle) or not 0 <= stream_handle < 2**64:
+        raise ValueError(f"stream={stream!r}: a torch.cuda.Stream or a CUstream handle (an integer)")
+    handle = native().open(config, int(num_envs), device, int(threads), asset_root or "", int(stream_handle))
+    return VecEnv(handle, config, seed, asset_root)
