@@ -58,8 +58,8 @@ def parse_args() -> Args:
 
 # ---- the network (spec 1.2, 1.3): Nature CNN torso, actor and critic heads ----
 
-def init_network(key, height: int, width: int):
-    torso, actor, critic = jax.random.split(key, 3)
+def init_network(torso, actor, critic, height: int, width: int):
+    """The parameters from the torso's, the actor's and the critic's keys."""
     k1, k2, k3, k4 = jax.random.split(torso, 4)
     orth = jax.nn.initializers.orthogonal  # a (kh, kw, in, out) kernel as a (kh*kw*in) x out matrix, as Flax
     gain = np.sqrt(2)
@@ -107,6 +107,21 @@ def adam_step(params, grads, opt, args: Args):
 
 # ---- PPO ----
 
+def gae(values, rewards, dones, last_value, last_done, gamma: float, lam: float):
+    """Advantages and returns [T, N] (spec 2.5.3). dones[t]: o_t starts an episode; last_value and last_done
+    are those of the observation after the last step. Truncation counts as termination: no bootstrap across it."""
+    def back(carry, x):
+        advantage, next_value, next_done = carry
+        value, reward, done = x
+        nonterm = 1.0 - next_done
+        delta = reward + gamma * next_value * nonterm - value
+        advantage = delta + gamma * lam * nonterm * advantage
+        return (advantage, value, done.astype(jnp.float32)), advantage
+    init = (jnp.zeros_like(last_value), last_value, last_done.astype(jnp.float32))
+    _, advantages = jax.lax.scan(back, init, (values, rewards, dones), reverse=True)
+    return advantages, advantages + values
+
+
 def make_train(args: Args, env):
     """init(seed) -> runner and iteration(runner) -> (runner, metrics), for one agent: vmap both."""
     n, t_steps = args.num_envs, args.num_steps
@@ -115,9 +130,9 @@ def make_train(args: Args, env):
     height, width, _ = env.single_observation_space.shape
 
     def init(seed):
-        # spec 2.4: the seed's key split into the carry key and the network's keys.
-        key, net_key = jax.random.split(jax.random.PRNGKey(seed))
-        params = init_network(net_key, height, width)
+        # spec 2.4: the seed's key split into the carry key and the torso's, actor's and critic's keys.
+        key, torso, actor, critic = jax.random.split(jax.random.PRNGKey(seed), 4)
+        params = init_network(torso, actor, critic, height, width)
         env_state, obs, _ = env.reset(seed.astype(jnp.uint32))
         return {"params": params, "opt": adam_init(params), "env": env_state, "obs": obs,
                 "done": jnp.zeros(n, bool), "key": key}
@@ -136,18 +151,6 @@ def make_train(args: Args, env):
                     "return": jnp.where(ended, finals["return"], 0.0).sum()}
         # dones[t]: o_t starts an episode, i.e. the previous step's flag (2.5.1d)
         return (params, env_state, next_obs, next_done, key), ((obs, action, logp, value, reward, done), episodes)
-
-    def gae(values, rewards, dones, last_value, last_done):  # spec 2.5.3
-        def back(carry, x):
-            advantage, next_value, next_done = carry
-            value, reward, done = x
-            nonterm = 1.0 - next_done
-            delta = reward + args.gamma * next_value * nonterm - value
-            advantage = delta + args.gamma * args.gae_lambda * nonterm * advantage
-            return (advantage, value, done.astype(jnp.float32)), advantage
-        init = (jnp.zeros_like(last_value), last_value, last_done.astype(jnp.float32))
-        _, advantages = jax.lax.scan(back, init, (values, rewards, dones), reverse=True)
-        return advantages, advantages + values
 
     def loss_fn(params, mb):  # spec 2.6
         obs, action, logp_old, value_old, advantage, returns = mb
@@ -177,7 +180,7 @@ def make_train(args: Args, env):
         params, env_state, obs, done, key = carry
         obs_b, actions, logps, values, rewards, dones = transitions
         _, last_value = network(params, obs)
-        advantages, returns = gae(values, rewards, dones, last_value, done)
+        advantages, returns = gae(values, rewards, dones, last_value, done, args.gamma, args.gae_lambda)
         flat = jax.tree.map(lambda x: x.reshape((batch,) + x.shape[2:]),
                             (obs_b, actions, logps, values, advantages, returns))
 

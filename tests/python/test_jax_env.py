@@ -1,6 +1,10 @@
 """kage.jax on the CPU against kage.make_vec, the reference for every byte: a jitted lax.scan of 600 steps
 (past the automatic reset at 500), vmap, several configs in one process, and the errors of make_env, of
 trace time, of out-of-range actions and of a handler inside jit."""
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -208,3 +212,10 @@ def test_make_env_errors_are_make_vecs():
         kage.jax.make_env("no/such.yaml", 2)
     with pytest.raises(ValueError, match="num_envs=0"):
         kage.jax.make_env(SIMPLEST, 0)
+
+
+def test_import_without_jax_says_how_to_get_it():
+    code = ("import sys\nsys.modules['jax'] = None  # as if JAX were not installed\n"
+            "try:\n    import kage.jax\nexcept ImportError as e:\n    print(e)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=dict(os.environ))
+    assert "kage.jax needs JAX: `pip install jax`" in done.stdout, done.stdout + done.stderr

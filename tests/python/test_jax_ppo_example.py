@@ -1,14 +1,49 @@
-"""examples/jax_ppo.py at a tiny size on the CPU: two agents vmapped, two iterations, each one jit."""
+"""examples/jax_ppo.py: its GAE and optimiser step against hand-computed values, and the whole learner at a tiny
+size on the CPU (two agents vmapped, two iterations, each one jit)."""
+import importlib.util
 import json
 import math
 import os
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
-pytest.importorskip("jax", reason="examples/jax_ppo.py needs JAX (pip install jax); CI installs it")
+jax = pytest.importorskip("jax", reason="examples/jax_ppo.py needs JAX (pip install jax); CI installs it")
+import jax.numpy as jnp  # noqa: E402
+
 from support import ROOT, SIMPLEST  # noqa: E402
+
+
+def example():
+    spec = importlib.util.spec_from_file_location("jax_ppo", ROOT / "examples/jax_ppo.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_gae_on_three_steps():
+    # gamma = lambda = 0.5; o_2 starts an episode (dones[2] = 1), so step 1 is an episode's last.
+    # t=2: delta = 2 + 0.5 * 4 - 3 = 1,            A = 1
+    # t=1: delta = 0 - 2 = -2 (no bootstrap),      A = -2
+    # t=0: delta = 1 + 0.5 * 2 - 1 = 1,            A = 1 + 0.25 * (-2) = 0.5
+    column = lambda *v: jnp.asarray(v, jnp.float32)[:, None]
+    advantages, returns = example().gae(column(1, 2, 3), column(1, 0, 2), column(0, 0, 1) > 0,
+                                        jnp.asarray([4.0]), jnp.asarray([False]), 0.5, 0.5)
+    np.testing.assert_allclose(np.asarray(advantages)[:, 0], [0.5, -2.0, 1.0])
+    np.testing.assert_allclose(np.asarray(returns)[:, 0], [1.5, 0.0, 4.0])
+
+
+def test_adam_step_clips_the_global_norm_first():
+    ppo = example()
+    args = ppo.Args(learning_rate=0.1, adam_eps=0.1, max_grad_norm=0.5)
+    params = {"a": jnp.float32(1.0), "b": jnp.float32(1.0)}
+    # |(3, 4)| = 5 > 0.5: the gradients become (0.3, 0.4). Adam's first step with bias correction moves each
+    # parameter by lr * g / (|g| + eps): 0.1 * 0.3 / 0.4 = 0.075 and 0.1 * 0.4 / 0.5 = 0.08.
+    new, opt = ppo.adam_step(params, {"a": jnp.float32(3.0), "b": jnp.float32(4.0)}, ppo.adam_init(params), args)
+    np.testing.assert_allclose([float(new["a"]), float(new["b"])], [1 - 0.075, 1 - 0.08], rtol=1e-6)
+    assert int(opt["count"]) == 1
 
 
 def test_two_seeds_train_two_iterations():
