@@ -14,9 +14,8 @@ import dataclasses
 import json
 
 import pytest
-import torch
 
-from kage.ppo import train
+from kage.ppo import checkpoint, train
 from support import CONFIGS
 
 FLAGS = dict(device="cpu", threads=1, total_timesteps=192, num_envs=2, num_steps=16, num_minibatches=2, update_epochs=2,
@@ -60,8 +59,8 @@ def test_a_pack_of_two_equals_two_lone_runs(tmp_path):
         assert any("train/avg_passed_distance" in r for r in ra), "episodes ended during training"
         for x, y in zip(ra, rb):
             compare_values(x, y, f"{a.out}:{x['kind']}:{x['iteration']}")
-        ca = torch.load(f"{a.out}/checkpoints/latest.pt", weights_only=False)
-        cb = torch.load(f"{b.out}/checkpoints/latest.pt", weights_only=False)
+        ca = checkpoint.load(f"{a.out}/checkpoints/latest.pt")
+        cb = checkpoint.load(f"{b.out}/checkpoints/latest.pt")
         assert ca["env_state"] == cb["env_state"], "the environments saw the same actions"
         steps = ca["optimizer_steps"]
         for name in ca["agent"]:

@@ -9,6 +9,7 @@ import time
 
 import torch
 
+from kage.ppo import checkpoint
 from support import CONFIGS
 
 TIMING = {"charts/SPS", "charts/SPS_update", "seconds"}
@@ -44,7 +45,7 @@ def test_killed_run_resumes_exactly(tmp_path):
     child.send_signal(signal.SIGKILL)
     child.wait()
     assert not (killed / "summary.json").exists()
-    interrupted_at = torch.load(killed / "checkpoints/latest.pt", weights_only=False)["iteration"]
+    interrupted_at = checkpoint.load(killed / "checkpoints/latest.pt")["iteration"]
     assert 1 <= interrupted_at < 6
 
     resumed = train(killed)
@@ -57,8 +58,8 @@ def test_killed_run_resumes_exactly(tmp_path):
     assert [r["iteration"] for r in got if r["kind"] == "train"] == [1, 2, 3, 4, 5, 6]
     assert [r["iteration"] for r in got if r["kind"] == "eval"] == [0, 2, 4, 6]
     assert got == want
-    a = torch.load(whole / "checkpoints/latest.pt", weights_only=False)
-    b = torch.load(killed / "checkpoints/latest.pt", weights_only=False)
+    a = checkpoint.load(whole / "checkpoints/latest.pt")
+    b = checkpoint.load(killed / "checkpoints/latest.pt")
     assert a["agent"].keys() == b["agent"].keys()
     for name in a["agent"]:
         assert torch.equal(a["agent"][name], b["agent"][name]), name

@@ -8,6 +8,9 @@ says otherwise:
   DIR/configs.md and DIR/configs.csv, and DIR/evaluation.json with every value;
 - --video OUT: one episode on the one --config, with the metrics beside each frame (kage.ppo.video).
 A checkpoint is refused on a config whose observation shape or action count differs from its network's.
+Checkpoints are read as data only (kage.ppo.checkpoint): scoring one that others share runs none of its
+contents. A checkpoint of another agent than the baseline's names its module; that module's code runs
+only when --agent names it on the command line.
 Both sides of every pair of a suite: `python3 -m kage.bench score CHECKPOINT --suite S` (kage.bench.score).
 """
 import argparse
@@ -19,7 +22,7 @@ from typing import List, Optional
 import torch
 
 import kage
-from kage.ppo import plugins, rundir, video
+from kage.ppo import checkpoint, plugins, rundir, video
 from kage.errors import ConfigError
 from kage.util import tables
 from kage.ppo.evaluation import METRICS, EvalSettings, evaluate, evaluation_seed
@@ -40,15 +43,15 @@ def checkpoint_file(path: str) -> str:
     return file
 
 
-def load_policy(file: str, device: str):
-    """The checkpoint's network (K = 1, evaluation mode) and what it was trained with (agent_spec)."""
+def load_policy(file: str, device: str, agent_flag: Optional[str] = None):
+    """The checkpoint's network (K = 1, evaluation mode) and what it was trained with (agent_spec). The network
+    is the baseline's, or `agent_flag`'s (--agent): never a module that only the checkpoint names."""
     try:
-        state = torch.load(file, map_location="cpu", weights_only=False)  # a kage.ppo.train checkpoint
-    except Exception as e:  # torch raises many kinds on a damaged or foreign file
-        fail(f"{file} is not a readable kage.ppo.train checkpoint ({type(e).__name__}: {e})")
-    if not (isinstance(state, dict) and "agent" in state and "iteration" in state):
-        fail(f"{file} is not a kage.ppo.train checkpoint (no parameters and iteration)")
-    spec = state.get("agent_spec") or spec_from_run_dir(file)
+        state = checkpoint.load(file)
+    except checkpoint.CheckpointError as e:
+        fail(str(e))
+    spec = dict(state.get("agent_spec") or spec_from_run_dir(file))
+    spec["agent"] = agent_to_import(file, plugins.current_reference(spec["agent"]), agent_flag)
     agent = plugins.build_agent(spec["agent"], spec["observation_shape"], spec["num_actions"], [spec["seed"]], device)
     with torch.no_grad():
         for name, p in agent.named_parameters():
@@ -58,6 +61,21 @@ def load_policy(file: str, device: str):
             agent.run_view(p)[0].copy_(state["agent"][name])
     agent.eval()
     return agent, spec, state
+
+
+def agent_to_import(file: str, recorded: str, agent_flag: Optional[str]) -> str:
+    """The agent factory to import: --agent if given (the user's consent to run that module), else the baseline's,
+    which is part of this package. A checkpoint naming another module without --agent is refused: importing a
+    module named by a file someone shared would run its code."""
+    if agent_flag:
+        if plugins.current_reference(agent_flag) != recorded:
+            print(f"kage.ppo.evaluate: note: {file} was trained with --agent {recorded}; building --agent {agent_flag}",
+                  file=sys.stderr)
+        return agent_flag
+    if recorded != plugins.BASELINE_AGENT:
+        fail(f"{file} was trained with --agent {recorded}; building its network imports that module, which runs its "
+             f"code: if you trust it, pass --agent {recorded}")
+    return recorded
 
 
 def spec_from_run_dir(file: str) -> dict:
@@ -132,6 +150,8 @@ def add_scoring_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--device", default="cuda", help="cuda or cpu")
     parser.add_argument("--threads", type=int, help="CPU threads (default: all cores)")
     parser.add_argument("--asset-root", help="resolve the configs' asset paths here")
+    parser.add_argument("--agent", help="module:factory of the checkpoint's network when it is not the baseline's "
+                                        "(importing it runs that module's code: name only code you trust)")
 
 
 def load_for_scoring(parser: argparse.ArgumentParser, options):
@@ -145,7 +165,7 @@ def load_for_scoring(parser: argparse.ArgumentParser, options):
         fail("--device cuda, but torch sees no GPU: use --device cpu")
     torch.set_num_threads(options.threads or os.cpu_count() or 1)
     file = checkpoint_file(options.checkpoint)
-    agent, spec, state = load_policy(file, options.device)
+    agent, spec, state = load_policy(file, options.device, options.agent)
     options.seed = spec["seed"] if options.seed is None else options.seed
     print(f"{parser.prog}: {file}: --agent {spec['agent']}, iteration {state['iteration']}, "
           f"step {state['global_step']:,}, seed {options.seed}", file=sys.stderr)

@@ -4,7 +4,8 @@
     DIR/configs/<label>.json     every config's resolved Spec (kagec resolve); "train" is the train config
     DIR/certificates/<label>.json  the train/eval pair's certificate (kagec diff --certify)
     DIR/metrics.jsonl            one row per iteration ("kind": "train") and per evaluation ("kind": "eval")
-    DIR/checkpoints/latest.pt    parameters, optimizer, random streams, environments' state, loop state
+    DIR/checkpoints/latest.pt    parameters, optimizer, random streams, environments' state, loop state: data
+                                 only (kage.ppo.checkpoint), never unpickled
     DIR/summary.json             at the end: min, mean, median and max of every evaluated value (§3.4)
 
 Nothing is lost when the process is killed: files are replaced atomically (written beside, then
@@ -14,7 +15,6 @@ finished run (summary.json) is never touched again; a config whose Spec changed 
 refused.
 """
 import dataclasses
-import io
 import json
 import math
 import os
@@ -27,7 +27,7 @@ from typing import Dict, List, Optional, Tuple
 import torch
 
 from kage import front_end, resources
-from kage.ppo import plugins
+from kage.ppo import checkpoint, plugins
 from kage.util.files import atomic_write, safe, write_json
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
@@ -158,9 +158,7 @@ class RunDir:
     def save_checkpoint(self, state: dict) -> None:
         """checkpoints/latest.pt, and latest.json naming its iteration (read by kage.bench to pack runs
         that resume from the same iteration without loading the checkpoints)."""
-        buffer = io.BytesIO()
-        torch.save(state, buffer)
-        atomic_write(os.path.join(self.path, "checkpoints", "latest.pt"), buffer.getvalue())
+        atomic_write(os.path.join(self.path, "checkpoints", "latest.pt"), checkpoint.encode(state))
         write_json(os.path.join(self.path, "checkpoints", "latest.json"), {"iteration": state["iteration"]})
 
     def load_checkpoint(self, device) -> Optional[dict]:
@@ -169,7 +167,10 @@ class RunDir:
         if not os.path.exists(path):
             self._truncate_log(-1)
             return None
-        state = torch.load(path, map_location="cpu", weights_only=False)  # our own file
+        try:
+            state = checkpoint.load(path)
+        except checkpoint.CheckpointError as e:
+            raise SystemExit(f"kage.ppo.train: {e}\nkage.ppo.train: to train anew, use another --out") from None
         self._truncate_log(state["iteration"])
         return state
 

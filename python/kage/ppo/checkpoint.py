@@ -1,0 +1,100 @@
+"""Checkpoint files that hold data only: reading one never runs code from it.
+
+A checkpoint is the nested dict kage.ppo.train keeps (tensors, numbers, strings, lists, the environments'
+saved state as bytes). On disk it is a torch.save file of three entries that torch.load(weights_only=True)
+reads on every torch this package supports (1.13 reads neither Python floats nor bytes that way):
+
+    "format"   FORMAT
+    "json"     the dict as JSON text (a uint8 tensor), each tensor replaced by {"__tensor__": i} and each bytes
+               value by {"__bytes__": i}
+    "tensors"  the list of those tensors (bytes values as uint8 tensors)
+
+Checkpoints written before this format (a pickled dict) are read with weights_only=True too, where the torch
+in use can (2.x); nothing is ever unpickled beyond what that loader allows.
+"""
+import io
+import json
+from typing import Any, List
+
+import torch
+
+FORMAT = "kage.ppo.checkpoint/2"
+
+
+class CheckpointError(Exception):
+    """A file that is not a checkpoint this package can read as data: the message names the file and why."""
+
+
+def encode(state: dict) -> bytes:
+    """The file's bytes for `state`."""
+    tensors: List[torch.Tensor] = []
+
+    def pack(value: Any) -> Any:
+        if isinstance(value, torch.Tensor):
+            tensors.append(value.detach().cpu())
+            return {"__tensor__": len(tensors) - 1}
+        if isinstance(value, (bytes, bytearray)):
+            tensors.append(torch.frombuffer(bytearray(value), dtype=torch.uint8) if value else
+                           torch.zeros(0, dtype=torch.uint8))
+            return {"__bytes__": len(tensors) - 1}
+        if isinstance(value, dict):
+            if not all(isinstance(k, str) for k in value):
+                raise TypeError(f"checkpoint keys must be strings, got {sorted(map(repr, value))[:3]}")
+            return {k: pack(v) for k, v in value.items()}
+        if isinstance(value, (list, tuple)):
+            return [pack(v) for v in value]
+        if value is None or isinstance(value, (bool, int, float, str)):
+            return value
+        raise TypeError(f"a checkpoint holds data only, not {type(value).__name__}")
+
+    text = json.dumps(pack(state), sort_keys=True).encode()  # Infinity and NaN as Python's json writes them
+    buffer = io.BytesIO()
+    torch.save({"format": FORMAT, "json": torch.frombuffer(bytearray(text), dtype=torch.uint8), "tensors": tensors},
+               buffer)
+    return buffer.getvalue()
+
+
+def load(path: str) -> dict:
+    """The state saved at `path`, read as data only; CheckpointError names the file and what is wrong."""
+    try:
+        raw = torch.load(path, map_location="cpu", weights_only=True)
+    except FileNotFoundError:
+        raise CheckpointError(f"{path}: no such file") from None
+    except Exception as e:  # torch raises many kinds on a damaged, foreign or code-carrying file
+        older = ("; a checkpoint of an older kage.ppo.train (a pickled dict) reads as data only with torch 2.x"
+                 if int(torch.__version__.split(".")[0]) < 2 else "")
+        raise CheckpointError(
+            f"{path}: cannot be read as data only ({type(e).__name__}: {str(e).splitlines()[0][:160]}): it is damaged, "
+            "is not a kage.ppo.train checkpoint, or holds Python objects that only unpickling would rebuild, which "
+            f"can run code{older}") from None
+    if isinstance(raw, dict) and raw.get("format") == FORMAT:
+        return _decode(path, raw)
+    if isinstance(raw, dict) and "agent" in raw and "iteration" in raw:
+        return raw  # the pickled dict of earlier versions, which the data-only loader could read
+    found = f"format {raw.get('format')!r}" if isinstance(raw, dict) and "format" in raw else type(raw).__name__
+    raise CheckpointError(f"{path}: not a kage.ppo.train checkpoint ({found}, expected {FORMAT})")
+
+
+def _decode(path: str, raw: dict) -> dict:
+    tensors = raw.get("tensors")
+    try:
+        tree = json.loads(bytes(raw["json"].numpy()).decode())
+    except (KeyError, ValueError, UnicodeDecodeError, TypeError, AttributeError) as e:
+        raise CheckpointError(f"{path}: its JSON part is damaged ({e})") from None
+
+    def unpack(value: Any) -> Any:
+        if isinstance(value, dict):
+            if value.keys() == {"__tensor__"} or value.keys() == {"__bytes__"}:
+                (kind, index), = value.items()
+                if not isinstance(tensors, list) or not isinstance(index, int) or not 0 <= index < len(tensors):
+                    raise CheckpointError(f"{path}: its JSON names tensor {index!r}, which the file lacks")
+                return bytes(tensors[index].numpy()) if kind == "__bytes__" else tensors[index]
+            return {k: unpack(v) for k, v in value.items()}
+        if isinstance(value, list):
+            return [unpack(v) for v in value]
+        return value
+
+    state = unpack(tree)
+    if not (isinstance(state, dict) and "agent" in state and "iteration" in state):
+        raise CheckpointError(f"{path}: not a kage.ppo.train checkpoint (no parameters and iteration)")
+    return state
