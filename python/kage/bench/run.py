@@ -40,7 +40,7 @@ from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
 from kage.bench.units import Unit, select, units_of
 from kage.errors import ConfigError
-from kage.util.files import atomic_write, write_json
+from kage.util.files import atomic_write, remove_strays, write_json
 from kage.util.stop import stop_children
 
 
@@ -293,6 +293,8 @@ def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
             print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
 
     os.makedirs(out, exist_ok=True)
+    for folder in ("", "packs", "slurm"):
+        remove_strays(os.path.join(out, folder))  # dead writers' temporary files (run directories: the trainer's)
     check_suite_unchanged(out, report)
     record_bench(out, suite, seeds, units, trainer_args, args.share_training)
     write_json(os.path.join(out, "suite.json"), report)

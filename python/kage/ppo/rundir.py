@@ -28,7 +28,7 @@ import torch
 
 from kage import front_end, resources
 from kage.ppo import checkpoint, plugins
-from kage.util.files import atomic_write, safe, write_json
+from kage.util.files import atomic_write, remove_strays, safe, write_json
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
 # Arguments added since runs were first written, with the value that means what a run without them did.
@@ -84,6 +84,8 @@ class RunDir:
                 raise SystemExit(f"kage.ppo.train: config '{config}' ({label}) not found")
             specs[label] = front_end.resolve(config, args.asset_root)
         described = {label: {"path": config, "spec_sha256": specs[label]["sha256"]} for label, config in configs}
+        for folder in ("", "configs", "certificates", "checkpoints", "videos"):
+            remove_strays(os.path.join(path, folder))  # a killed writer's, or one that met a full disk
         run_json = os.path.join(path, "run.json")
         if os.path.exists(run_json):
             with open(run_json) as f:

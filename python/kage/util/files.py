@@ -1,19 +1,86 @@
 """Files that are replaced whole: a reader, or a process killed while writing, sees the old or the new
-content, never a part."""
+content, never a part.
+
+The content goes to a temporary file beside the target, NAME.tmp.<host>.<pid>.<random>: created exclusively
+(an existing file or a planted symlink at that name makes the create fail instead of being followed),
+unpredictable, removed when the write fails (a full disk keeps no stray), and named by its writer, so that
+remove_strays can tell a dead writer's leftovers from a live one's (processes of several hosts may share a
+directory: a Slurm array)."""
+import errno
 import json
 import os
+import re
+import secrets
 import socket
+import time
+
+STRAY_AGE_S = 3600  # another host's temporary file this old is a dead writer's: a write takes seconds
+_TEMPORARY = re.compile(r"^.+\.tmp\.(?P<host>[^/]+?)\.(?P<pid>\d+)(?:\.[0-9a-f]+)?$")
 
 
 def atomic_write(path: str, data: bytes) -> None:
-    """Writes `data` beside `path`, syncs it, then renames it over `path`. The temporary name is the
-    writer's own (host and process), for processes of several hosts sharing a directory (a Slurm array)."""
-    tmp = f"{path}.tmp.{socket.gethostname()}.{os.getpid()}"
-    with open(tmp, "wb") as f:
-        f.write(data)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    """Writes `data` to a new temporary file beside `path`, syncs it, then renames it over `path`."""
+    name, fd = _create_temporary(path)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(name, path)
+    except BaseException:
+        _unlink(name)
+        raise
+
+
+def _create_temporary(path: str):
+    """(name, file descriptor) of a new file beside `path` that nobody else could have created or planted."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+    for _ in range(100):
+        name = f"{path}.tmp.{socket.gethostname()}.{os.getpid()}.{secrets.token_hex(6)}"
+        try:
+            return name, os.open(name, flags, 0o666)
+        except FileExistsError:
+            continue
+    raise FileExistsError(errno.EEXIST, "no unused temporary name after 100 tries", path)
+
+
+def remove_strays(directory: str) -> None:
+    """Removes the temporary files of atomic_write in `directory` whose writer is gone: this host's whose
+    process no longer runs, and any older than STRAY_AGE_S. Live writers' files are left alone."""
+    try:
+        names = os.listdir(directory)
+    except FileNotFoundError:
+        return
+    host, now = socket.gethostname(), time.time()
+    for name in names:
+        m = _TEMPORARY.match(name)
+        if not m:
+            continue
+        path = os.path.join(directory, name)
+        try:
+            age = now - os.lstat(path).st_mtime
+        except FileNotFoundError:
+            continue
+        if (m["host"] == host and not process_alive(int(m["pid"]))) or age > STRAY_AGE_S:
+            _unlink(path)
+
+
+def _unlink(path: str) -> None:
+    try:
+        os.unlink(path)
+    except FileNotFoundError:
+        pass
+
+
+def process_alive(pid: int) -> bool:
+    """Whether a process with this id runs on this host."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
 
 
 def write_json(path: str, value) -> None:
