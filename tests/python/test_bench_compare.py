@@ -67,7 +67,7 @@ def test_compare_by_hand(two):
                                                                                       "all pairs")]
     with open(out / "improvement.csv") as f:
         assert float(next(csv.DictReader(f))["p"]) == pytest.approx(14 / 18)
-    for name in ("intervals.png", "profile_success.png"):
+    for name in ("intervals.png", "profile_success_once.png"):
         data = (out / "plots" / name).read_bytes()
         assert data.startswith(PNG_SIGNATURE) and len(data) > 5000, name
     assert json.loads((out / "compare.json").read_text()) == result
@@ -100,7 +100,8 @@ def test_refuses_another_suite(two):
 def test_refuses_other_seeds(two, tmp_path):
     a, _ = two
     fewer = method(tmp_path / "D", {"background/1": [0.1, 0.2]}, seeds=(1, 2))
-    with pytest.raises(SystemExit, match=r"have other seeds \(\[1, 2, 3\] and \[1, 2\]\): run both with the same --seeds"):
+    with pytest.raises(SystemExit,
+                       match=r"have other seeds \(\[1, 2, 3\] and \[1, 2\]\): run both with the same --seeds"):
         compare.compare([str(a), str(fewer)], reps=100)
 
 
@@ -145,9 +146,11 @@ def trained(tmp_path_factory):
 
 
 def test_compare_end_to_end(trained):
+    # progress: after 128 steps no run succeeds, but they move
     done = bench_cli("compare", str(trained / "baseline"), str(trained / "shift"), "--reps", "1000",
-                     "--out", str(trained / "out"))
+                     "--out", str(trained / "out"), "--metric", "progress")
     assert done.returncode == 0, done.stderr
+    assert "## Probability of improvement of eval `progress`" in done.stdout
     assert "| axis | pairs | P(baseline > shift) |" in done.stdout
     result = json.loads((trained / "out" / "compare.json").read_text())
     assert [m["name"] for m in result["methods"]] == ["baseline", "shift"]
@@ -155,7 +158,8 @@ def test_compare_end_to_end(trained):
     assert result["protocol"]["total_timesteps"] == int(TINY[TINY.index("--total-timesteps") + 1])
     for r in result["improvement"]:
         assert r["n_pairs"] >= 1 and 0.0 <= r["p"]["low"] <= r["p"]["point"] <= r["p"]["high"] <= 1.0
-    assert (trained / "out" / "plots" / "intervals.png").read_bytes().startswith(PNG_SIGNATURE)
+    for name in ("intervals.png", "profile_progress.png"):
+        assert (trained / "out" / "plots" / name).read_bytes().startswith(PNG_SIGNATURE)
 
 
 def test_compare_end_to_end_refuses_another_protocol(trained):

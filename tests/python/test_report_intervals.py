@@ -73,6 +73,7 @@ def test_interval_files(bench):
     path, result = bench
     out = path / "report"
     md = (out / "intervals.md").read_text()
+    assert "## Interval estimates of `success_once`" in md
     assert "| background | 2 | 5 | 0.33 [" in md and "| 62.5 % [" in md
     assert "| layout | 1 | 1 | 0.00 [0.00, 0.00] | 0.00 [0.00, 0.00] | n/a |" in md
     assert "| filters | 0 | 0 | - | - | - |" in md
@@ -83,7 +84,7 @@ def test_interval_files(bench):
     assert rows["layout"]["drop_pct"] == "" and rows["layout"]["drop_undefined_fraction"] == "1.0"
     report_md = (out / "report.md").read_text()
     assert report_md.index("## Per axis") < report_md.index("## Interval estimates") < report_md.index("## Per pair")
-    for name in ("intervals.png", "profile_success.png"):
+    for name in ("intervals.png", "profile_success_once.png"):
         data = (out / "plots" / name).read_bytes()
         assert data.startswith(PNG_SIGNATURE) and len(data) > 5000, name
     assert {"intervals.md", "intervals.csv", "plots/intervals.png"} <= set(result["files"])
@@ -132,16 +133,37 @@ def test_protocol_final_takes_the_last_evaluation(tmp_path):
         report.report(str(tmp_path), protocol="best")
 
 
-def test_shared_runs_are_one_group():
-    # level-1 records of two pairs trained by one shared run and of a pair trained alone
-    def record(pair_name, unit, seed, train, evaluated):
-        return {"pair": pair_name, "unit": unit, "seed": seed,
+def test_pairs_of_one_train_config_are_one_group():
+    # A run depends only on its train config and seed: a/1 and a/2 (train config "ta") have the same runs, b/1
+    # (train config "tb") its own; a/3 (also "ta") lacks seed 2 so far, and is resampled on its own.
+    def record(pair_name, seed, train, evaluated):
+        return {"pair": pair_name, "unit": pair_name, "seed": seed,
                 "metrics": {"success_once": {"train": train, "eval": evaluated}}}
-    level1 = [record("a/1", "shared/x", 1, 0.9, 0.5), record("a/2", "shared/x", 1, 0.9, 0.4),
-              record("a/1", "shared/x", 2, 0.8, 0.3), record("a/2", "shared/x", 2, 0.8, 0.2),
-              record("b/1", "b/1", 3, 0.7, 0.1)]
-    scores = intervals.scores_of(level1, ["a/1", "a/2", "b/1", "c/1"])
-    assert scores.pairs == ["a/1", "a/2", "b/1"] and scores.seeds == [1, 2, 3]
-    assert scores.groups == ["shared/x", "shared/x", "b/1"]
-    np.testing.assert_array_equal(scores.eval, [[0.5, 0.4, np.nan], [0.3, 0.2, np.nan], [np.nan, np.nan, 0.1]])
+    level1 = [record("a/1", 1, 0.9, 0.5), record("a/2", 1, 0.9, 0.4), record("a/1", 2, 0.8, 0.3),
+              record("a/2", 2, 0.8, 0.2), record("b/1", 3, 0.7, 0.1), record("a/3", 1, 0.9, 0.6)]
+    pairs = [{"pair": name, "train_spec": spec} for name, spec in
+             (("a/1", "ta"), ("a/2", "ta"), ("b/1", "tb"), ("c/1", "tc"), ("a/3", "ta"))]
+    scores = intervals.scores_of(level1, pairs)
+    assert scores.pairs == ["a/1", "a/2", "b/1", "a/3"] and scores.seeds == [1, 2, 3]
+    assert scores.groups == ["ta seeds [0, 1]", "ta seeds [0, 1]", "tb seeds [2]", "ta seeds [0]"]
+    np.testing.assert_array_equal(scores.eval, [[0.5, 0.4, np.nan, 0.6], [0.3, 0.2, np.nan, np.nan],
+                                                [np.nan, np.nan, 0.1, np.nan]])
     np.testing.assert_array_equal(scores.train[:, 0], [0.9, 0.8, np.nan])
+
+
+def test_metric_progress(tmp_path):
+    # No run succeeds, so success gives no drop; progress does.
+    write_suite(tmp_path, [pair("background/1", "background")])
+    for seed, (train, evaluated) in {1: (0.8, 0.2), 2: (0.6, 0.4), 3: (0.7, 0.3)}.items():
+        write_run(tmp_path, "background/1", seed, ["eval"],
+                  plain(0.0, 0.0, **{"train/progress": train, "eval/eval/progress": evaluated}),
+                  rows=rows_for([(0.0, 0.0)]))
+    result = report.report(str(tmp_path), reps=500, metric="progress")
+    row = by_name(result["intervals"]["rows"], "name", "background")
+    # three values each: nothing cut, so the IQMs are the means 0.7 and 0.3
+    assert row["train_iqm"]["point"] == pytest.approx(0.7) and row["eval_iqm"]["point"] == pytest.approx(0.3)
+    assert row["drop_pct"]["point"] == pytest.approx(100 * 0.4 / 0.7)
+    assert "## Interval estimates of `progress`" in (tmp_path / "report" / "intervals.md").read_text()
+    assert (tmp_path / "report" / "plots" / "profile_progress.png").read_bytes().startswith(PNG_SIGNATURE)
+    with pytest.raises(SystemExit, match="take success_once, success, progress, not 'passed_distance'"):
+        report.report(str(tmp_path), reps=100, metric="passed_distance")

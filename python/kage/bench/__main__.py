@@ -7,7 +7,8 @@ from typing import List, Optional
 def main(argv: Optional[List[str]] = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     parser = argparse.ArgumentParser(prog="python3 -m kage.bench", description=__doc__)
-    commands = parser.add_subparsers(dest="command", required=True, metavar="{run,slurm,status,report,compare,score,speed}")
+    commands = parser.add_subparsers(dest="command", required=True,
+                                     metavar="{run,slurm,status,report,compare,score,speed}")
     commands.add_parser("run", help="train every (pair, seed) of a suite; trainer flags pass through",
                         add_help=False)
     commands.add_parser("slurm", help="write (or submit) a Slurm job array over the suite's runs", add_help=False)
@@ -23,8 +24,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     report.add_argument("--protocol", choices=("max", "final"), default="max",
                         help="a run's value: its maximum over training (the paper's) or its last evaluation")
     report.add_argument("--reps", type=int, default=50000, help="bootstrap resamples of the interval estimates")
+    report.add_argument("--metric", choices=("success_once", "success", "progress"), default="success_once",
+                        help="the metric of the interval estimates and profiles")
     report.add_argument("--partial", action="store_true",
-                        help="an interim report: unfinished runs too, at their latest evaluation (default DIR/report_interim)")
+                        help="an interim report: unfinished runs too, at their latest evaluation "
+                             "(default DIR/report_interim)")
     if argv[:1] == ["run"]:
         from kage.bench import run
         return run.main(argv[1:])
@@ -46,7 +50,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         status_module.status(args.dir, sys.stdout)
         return 0
     from kage.bench import report as report_module
-    written = report_module.report(args.dir, args.out, args.protocol, args.reps, args.partial)
+    written = report_module.report(args.dir, args.out, args.protocol, args.reps, args.partial, args.metric)
     print(f"kage.bench report: wrote {written['out_dir']}", file=sys.stderr)
     return 0
 

@@ -1,4 +1,5 @@
 """python3 -m kage.bench compare DIR_A DIR_B [DIR_C ...] [--names A B ...] [--out DIR] [--protocol max|final]
+    [--metric success_once|success|progress]
 
 Two or more benchmark directories of one suite side by side, each a method (for example the baseline and the
 agent trained on randomly shifted frames), with the report's interval estimates (kage.bench.intervals) per axis
@@ -10,6 +11,9 @@ and over all plain pairs:
   interval from resampling each method's runs within each pair, independently of the other method's;
 - the report's interval plot and performance profile with the methods overlaid.
 
+Success is `success_once`; --metric chooses `success` or `progress` instead (after a few thousand steps no agent
+succeeds, while their progress already differs).
+
 Only finished runs enter, each scored as `kage.bench report --protocol` scores it. The directories must have the
 same suite (the same pairs with the same train and eval Specs), the same seeds and pairs run, and the same
 training and evaluation protocol (run.json: total steps, steps between evaluations, evaluation episodes and
@@ -18,7 +22,7 @@ methods are named after their directories unless --names is given.
 
 Output, in DIR_A/compare/ (or --out): compare.md, compare.csv (the estimates, one row per method and axis),
 improvement.csv (P(X > Y) per axis and pair of methods), compare.json (everything) and plots/intervals.png,
-plots/profile_success.png.
+plots/profile_<metric>.png.
 """
 import argparse
 import json
@@ -62,7 +66,7 @@ def schedule_of(run: report.Run) -> dict:
             "eval_greedy": args.get("eval_greedy")}
 
 
-def load(bench_dir: str, name: str, protocol: str, reps: int) -> Method:
+def load(bench_dir: str, name: str, protocol: str, reps: int, metric: str) -> Method:
     suite, bench, units, runs = report.read_benchmark(bench_dir)
     every_run = [r for unit_runs in runs.values() for r in unit_runs]
     schedules = {json.dumps(schedule_of(r), sort_keys=True) for r in every_run if r.args}
@@ -75,7 +79,7 @@ def load(bench_dir: str, name: str, protocol: str, reps: int) -> Method:
         fail(f"{bench_dir} has no plain pair (only sweeps): compare reads plain pairs")
     return Method(name, bench_dir, suite, sorted(seeds), sorted(p["pair"] for u in units for p in u.pairs),
                   json.loads(schedules.pop()) if schedules else {}, levels,
-                  intervals.interval_report(levels["runs"], levels["pairs"], reps))
+                  intervals.interval_report(levels["runs"], levels["pairs"], reps, metric))
 
 
 def suite_differences(a: Method, b: Method) -> List[str]:
@@ -114,9 +118,10 @@ def check_comparable(methods: List[Method]) -> None:
                  "evaluated alike")
 
 
-def improvement(x: Method, y: Method, pair_names: List[str], reps: int) -> dict:
-    """P(X > Y) of eval success over the named pairs that both methods have runs of."""
-    sx, sy = intervals.scores_of(x.levels["runs"], pair_names), intervals.scores_of(y.levels["runs"], pair_names)
+def improvement(x: Method, y: Method, pairs: List[dict], reps: int) -> dict:
+    """P(X > Y) of the eval metric over the `pairs` (level-2 entries) that both methods have runs of."""
+    metric = x.estimates["metric"]
+    sx, sy = intervals.scores_of(x.levels["runs"], pairs, metric), intervals.scores_of(y.levels["runs"], pairs, metric)
     common = [p for p in sx.pairs if p in sy.pairs]
     if not common:
         return {"n_pairs": 0, "p": None}
@@ -129,15 +134,15 @@ def improvement(x: Method, y: Method, pair_names: List[str], reps: int) -> dict:
 def improvements(methods: List[Method], reps: int) -> List[dict]:
     """For each two methods (in the order given) and each scope: per axis, then over all plain pairs."""
     pairs = methods[0].levels["pairs"]
-    scopes: Dict[str, List[str]] = {}
+    scopes: Dict[str, List[dict]] = {}
     for p in pairs:
-        scopes.setdefault(p["axis"], []).append(p["pair"])
-    scopes[intervals.ALL_PAIRS] = [p["pair"] for p in pairs]
+        scopes.setdefault(p["axis"], []).append(p)
+    scopes[intervals.ALL_PAIRS] = pairs
     rows = []
     for i, x in enumerate(methods):
         for y in methods[i + 1:]:
             rows += [{"scope": "all" if name == intervals.ALL_PAIRS else "axis", "name": name, "x": x.name,
-                      "y": y.name, **improvement(x, y, names, reps)} for name, names in scopes.items()]
+                      "y": y.name, **improvement(x, y, members, reps)} for name, members in scopes.items()]
     return rows
 
 
@@ -159,17 +164,18 @@ def md_improvements(rows: List[dict]) -> str:
 
 
 def markdown(methods: List[Method], rows: List[dict], protocol: str) -> str:
+    metric = methods[0].estimates["metric"]
     listed = "; ".join(f"**{m.name}**: `{m.bench_dir}`, {len({(r['unit'], r['seed']) for r in m.levels['runs']})} "
                        "finished runs" for m in methods)
     schedule = ", ".join(f"{k} {v}" for k, v in methods[0].schedule.items() if v is not None) or "not recorded"
     return (f"# {methods[0].suite.get('suite', 'suite')}: {' vs '.join(m.name for m in methods)}\n\n"
             f"Methods: {listed}. Seeds {methods[0].seeds}; the same suite, seeds, pairs and protocol ({schedule}). "
             f"{report.LEVEL_1[protocol][0].upper()}{report.LEVEL_1[protocol][1:]}.\n\n"
-            f"## IQM of eval success (`{SUCCESS_SHOWN}`)\n\n{md_estimates(methods, 'eval_iqm', fmt_interval)}\n"
-            f"## IQM of train success\n\n{md_estimates(methods, 'train_iqm', fmt_interval)}\n"
-            f"## Success drop\n\n{md_estimates(methods, 'drop_pct', fmt_drop)}\n"
-            f"## Probability of improvement of eval success\n\n{md_improvements(rows)}\n"
-            "P(X > Y): per pair, the probability that a run of X has a higher eval success than a run of Y (ties "
+            f"## IQM of eval `{metric}`\n\n{md_estimates(methods, 'eval_iqm', fmt_interval)}\n"
+            f"## IQM of train `{metric}`\n\n{md_estimates(methods, 'train_iqm', fmt_interval)}\n"
+            f"## Drop of `{metric}`\n\n{md_estimates(methods, 'drop_pct', fmt_drop)}\n"
+            f"## Probability of improvement of eval `{metric}`\n\n{md_improvements(rows)}\n"
+            f"P(X > Y): per pair, the probability that a run of X has a higher eval {metric} than a run of Y (ties "
             "count half), averaged over the pairs both have runs of; 0.5 is no difference. Its interval resamples "
             "each method's runs within each pair, independently of the other method's.\n\n"
             f"{explanation(methods[0].estimates)}\n")
@@ -197,14 +203,16 @@ def method_names(dirs: List[str], names: Optional[List[str]]) -> List[str]:
 
 
 def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optional[str] = None,
-            protocol: str = "max", reps: int = intervals.REPS) -> dict:
+            protocol: str = "max", reps: int = intervals.REPS, metric: str = SUCCESS_SHOWN) -> dict:
     """Compares the benchmark directories `dirs` (see the module's docstring), writes the tables and plots into
     `out_dir` (default dirs[0]/compare) and returns compare.json's content."""
     if len(dirs) < 2:
         fail("give two or more benchmark directories")
     if protocol not in report.PROTOCOLS:
         fail(f"unknown protocol '{protocol}': choose {' or '.join(report.PROTOCOLS)}")
-    methods = [load(d, name, protocol, reps) for d, name in zip(dirs, method_names(dirs, names))]
+    if metric not in intervals.METRICS:
+        fail(f"--metric takes {', '.join(intervals.METRICS)}, not '{metric}'")
+    methods = [load(d, name, protocol, reps, metric) for d, name in zip(dirs, method_names(dirs, names))]
     check_comparable(methods)
     rows = improvements(methods, reps)
     out_dir = out_dir or os.path.join(dirs[0], "compare")
@@ -228,10 +236,11 @@ def write(out_dir: str, methods: List[Method], result: dict) -> None:
              "improvement.csv": improvement_csv(result["improvement"]).encode()}
     result["plots_note"] = None
     try:
-        files["plots/intervals.png"] = plots.interval_estimates({m.name: m.estimates["rows"] for m in methods})
+        metric = methods[0].estimates["metric"]
+        files["plots/intervals.png"] = plots.interval_estimates({m.name: m.estimates["rows"] for m in methods}, metric)
         profiles = {m.name: m.estimates["profile"]["eval"] for m in methods if m.estimates["profile"]}
         if profiles:
-            files["plots/profile_success.png"] = plots.performance_profiles(intervals.TAUS, profiles)
+            files[f"plots/profile_{metric}.png"] = plots.performance_profiles(intervals.TAUS, profiles, metric=metric)
     except ImportError as e:  # the tables do not need matplotlib
         result["plots_note"] = f"no plots: {e}; install matplotlib (pip install matplotlib) and rerun"
         print(f"kage.bench compare: {result['plots_note']}", file=sys.stderr)
@@ -249,8 +258,10 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser.add_argument("--protocol", choices=report.PROTOCOLS, default="max",
                         help="a run's value: its maximum over training (the paper's) or its last evaluation")
     parser.add_argument("--reps", type=int, default=intervals.REPS, help="bootstrap resamples of the intervals")
+    parser.add_argument("--metric", choices=intervals.METRICS, default=SUCCESS_SHOWN,
+                        help="the eval metric compared (default success_once)")
     args = parser.parse_args(argv)
-    result = compare(args.dirs, args.names, args.out, args.protocol, args.reps)
+    result = compare(args.dirs, args.names, args.out, args.protocol, args.reps, args.metric)
     with open(os.path.join(result["out_dir"], "compare.md"), encoding="utf-8") as f:
         sys.stdout.write(f.read())
     print(f"kage.bench compare: wrote {result['out_dir']}", file=sys.stderr)

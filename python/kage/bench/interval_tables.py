@@ -10,7 +10,7 @@ CSV_COLUMNS = ("scope", "name", "n_pairs", "n_runs", "eval_iqm", "eval_iqm_low",
 
 
 def fmt_interval(estimate: Optional[dict]) -> str:
-    """Success values, so two decimals."""
+    """Shares (success, progress), so two decimals."""
     if estimate is None:
         return "-"
     return f"{estimate['point']:.2f} [{estimate['low']:.2f}, {estimate['high']:.2f}]"
@@ -32,7 +32,8 @@ def explanation(estimates: dict) -> str:
             "the row's pairs and seeds pooled. drop: 100 (train - eval) / train of the mean over pairs of the mean "
             "over seeds, as in the axes table. Brackets: 95 % percentile intervals of "
             f"{estimates['reps']:,} stratified bootstrap resamples (seed {estimates['seed']}): runs resampled within "
-            "each pair, the pairs of one shared run together, each run's train and eval values together. n/a: "
+            "each pair, the pairs of one train config together (their runs train the same agent), each run's "
+            "train and eval values together. n/a: "
             "the train mean is 0 (in the sample, or in some resamples: then no interval).")
 
 
@@ -44,7 +45,7 @@ def md_rows(rows: List[dict]) -> str:
 
 def md_intervals(estimates: dict, level: int) -> str:
     """The report's section: one row per axis and one over all pairs."""
-    return (f"{'#' * level} Interval estimates of success (`{estimates['metric']}`)\n\n{md_rows(estimates['rows'])}\n"
+    return (f"{'#' * level} Interval estimates of `{estimates['metric']}`\n\n{md_rows(estimates['rows'])}\n"
             f"{explanation(estimates)}\n")
 
 

@@ -7,10 +7,16 @@
   and no interval where a resample's train mean is 0 (the share of such resamples is given);
 - the performance profile over all plain pairs: the fraction of runs whose score is above each threshold.
 
-A run's score is the report's level-1 value (kage.bench.report: the maximum over training or the last evaluation).
-The pairs are the tasks and the seeds the runs; a pair missing a seed has a gap there. Under --share-training the
-pairs that one shared run evaluates have the same runs, and are resampled together (stats' groups, one per run
-unit). The bootstrap draws from its own generator, seeded with SEED, so a report is the same every time.
+A run's score is the report's level-1 value (kage.bench.report: the maximum over training or the last evaluation) of
+`success_once`, or of another metric of METRICS (--metric: at a few thousand steps no agent succeeds, while its
+progress already differs).
+The pairs are the tasks and the seeds the runs; a pair missing a seed has a gap there. A run depends only on its
+train config, seed and flags, so the pairs of one train config have the same runs: one shared run under
+--share-training, or identical separate runs without it (the 34 KAGE-Bench pairs have 7 train configs). Their
+scores move together, and they are resampled together (stats' groups: one per train config Spec and set of seeds
+run; a pair of that config whose runs are not all there yet is resampled on its own, which narrows the intervals
+a little until they are). The bootstrap draws from its own generator, seeded with SEED, so a report is the same
+every time.
 """
 from typing import Dict, List, NamedTuple, Optional
 
@@ -24,6 +30,7 @@ REPS = 50000
 SEED = 0
 TAUS = np.arange(101) / 100  # 0, 0.01, ..., 1: each the double nearest its decimal
 ALL_PAIRS = "all pairs"
+METRICS = (SUCCESS_SHOWN, "success", "progress")  # shares of episodes or of the distance: the profile's 0..1 fits
 
 
 class Scores(NamedTuple):
@@ -31,25 +38,27 @@ class Scores(NamedTuple):
 
     pairs: List[str]
     seeds: List[int]
-    groups: List[str]  # per pair, the run unit that trained it
+    groups: List[str]  # per pair, its train config and the seeds it has: pairs alike share their runs
     train: np.ndarray
     eval: np.ndarray
 
 
-def scores_of(level1: List[dict], pair_names: List[str], metric: str = SUCCESS_SHOWN) -> Scores:
-    """The level-1 values of `metric` of the named pairs' runs; pairs without a run are left out."""
-    records = [r for r in level1 if r["pair"] in pair_names and r["metrics"][metric]["train"] is not None
+def scores_of(level1: List[dict], pairs: List[dict], metric: str = SUCCESS_SHOWN) -> Scores:
+    """The level-1 values of `metric` of the runs of `pairs` (level-2 entries: "pair" and "train_spec"); pairs
+    without a run are left out."""
+    train_of = {p["pair"]: p["train_spec"] for p in pairs}
+    records = [r for r in level1 if r["pair"] in train_of and r["metrics"][metric]["train"] is not None
                and r["metrics"][metric]["eval"] is not None]
-    pairs = [p for p in pair_names if any(r["pair"] == p for r in records)]
+    names = [p["pair"] for p in pairs if any(r["pair"] == p["pair"] for r in records)]
     seeds = sorted({r["seed"] for r in records})
-    train = np.full((len(seeds), len(pairs)), np.nan)
-    evaluated = np.full((len(seeds), len(pairs)), np.nan)
-    groups = [""] * len(pairs)
+    train = np.full((len(seeds), len(names)), np.nan)
+    evaluated = np.full((len(seeds), len(names)), np.nan)
     for r in records:
-        i, j = seeds.index(r["seed"]), pairs.index(r["pair"])
+        i, j = seeds.index(r["seed"]), names.index(r["pair"])
         train[i, j], evaluated[i, j] = r["metrics"][metric]["train"], r["metrics"][metric]["eval"]
-        groups[j] = r["unit"]
-    return Scores(pairs, seeds, groups, train, evaluated)
+    groups = [f"{train_of[name]} seeds {np.flatnonzero(~np.isnan(evaluated[:, j])).tolist()}"
+              for j, name in enumerate(names)]
+    return Scores(names, seeds, groups, train, evaluated)
 
 
 def estimate(scope: str, name: str, scores: Scores, reps: int) -> dict:
@@ -75,19 +84,19 @@ def profile(scores: Scores, reps: int) -> Optional[dict]:
     return {"taus": TAUS.tolist(), **curves}
 
 
-def interval_report(level1: List[dict], pairs: List[dict], reps: int = REPS) -> dict:
-    """report.json's "intervals": a row per axis (in the order of `pairs`, the plain pairs of level 2) and one
-    over all plain pairs, and the profile over all of them."""
-    axes: Dict[str, List[str]] = {}
+def interval_report(level1: List[dict], pairs: List[dict], reps: int = REPS, metric: str = SUCCESS_SHOWN) -> dict:
+    """report.json's "intervals" of `metric`: a row per axis (in the order of `pairs`, the plain pairs of level 2)
+    and one over all plain pairs, and the profile over all of them."""
+    axes: Dict[str, List[dict]] = {}
     for p in pairs:
-        axes.setdefault(p["axis"], []).append(p["pair"])
-    everything = scores_of(level1, [p["pair"] for p in pairs])
-    rows = [estimate("axis", axis, scores_of(level1, names), reps) for axis, names in axes.items()]
+        axes.setdefault(p["axis"], []).append(p)
+    everything = scores_of(level1, pairs, metric)
+    rows = [estimate("axis", axis, scores_of(level1, members, metric), reps) for axis, members in axes.items()]
     rows.append(estimate("all", ALL_PAIRS, everything, reps))
-    return {"metric": SUCCESS_SHOWN, "confidence": CONFIDENCE, "reps": reps, "seed": SEED,
+    return {"metric": metric, "confidence": CONFIDENCE, "reps": reps, "seed": SEED,
             "iqm": "interquartile mean of the per-run scores, the scope's pairs and seeds pooled (rliable)",
             "drop_pct": "100 (train - eval) / train of the mean over pairs of the mean over seeds; the bootstrap "
                         "resamples each run's (train, eval) pair together",
-            "bootstrap": "stratified: runs resampled within each pair, the pairs of one shared run together; "
+            "bootstrap": "stratified: runs resampled within each pair, the pairs of one train config together; "
                          "percentile intervals",
             "rows": rows, "profile": profile(everything, reps)}

@@ -9,10 +9,11 @@
     sweep_<sweep>.png         per sweep: eval success_once against the swept value (mean ± SEM over seeds),
                               the train config's value as a dashed line
     intervals.png             rliable's interval plot: per axis and over all pairs, the IQM of eval success and
-                              the success drop, each a bar over its 95 % interval with a tick at the point
-                              (kage.bench compare: one bar per method)
-    profile_success.png       performance profiles: the fraction of runs whose success exceeds each threshold,
-                              with a 95 % band; eval (and train, dashed) in the report, eval per method in compare
+                              the success drop (or of --metric), each a bar over its 95 % interval with a tick at
+                              the point (kage.bench compare: one bar per method)
+    profile_<metric>.png      performance profiles: the fraction of runs whose success_once (or --metric) exceeds
+                              each threshold, with a 95 % band; eval (and train, dashed) in the report, eval per
+                              method in compare
 
 The curves take every run's evaluation rows, finished or not: at each step the mean is over the runs that
 reached it, so an unfinished run stops contributing after its last evaluation; the title then says how many
@@ -125,14 +126,16 @@ def sweep_response(title: str, names: List[str], evaluated: List[dict], train: d
     return png_bytes(figure, interim)
 
 
-def interval_estimates(methods: Dict[str, List[dict]], interim: Optional[str] = None) -> bytes:
+def interval_estimates(methods: Dict[str, List[dict]], metric: str = "success_once",
+                       interim: Optional[str] = None) -> bytes:
     """Per row of kage.bench.intervals (the axes, then all pairs), a bar over each method's 95 % interval and a
-    black tick at its point: the IQM of eval success on the left, the drop (%) on the right. `methods` maps a
+    black tick at its point: the IQM of eval `metric` on the left, its drop (%) on the right. `methods` maps a
     name ("" for the report's one method) to its rows, the same rows in the same order for every method."""
     names = [r["name"] for r in next(iter(methods.values()))]
     figure, panels = new_figure((8.4, 1.2 + 0.42 * len(names) * max(1, len(methods) / 2)), columns=2)
     height = 0.8 / len(methods)
-    for panel, key, xlabel in ((panels[0], "eval_iqm", "IQM of eval success"), (panels[1], "drop_pct", "success drop (%)")):
+    for panel, key, xlabel in ((panels[0], "eval_iqm", f"IQM of eval {metric}"),
+                               (panels[1], "drop_pct", f"{metric} drop (%)")):
         for i, (method, rows) in enumerate(methods.items()):
             colour = METHOD_COLOURS[i % len(METHOD_COLOURS)]
             for y, row in enumerate(rows):
@@ -148,7 +151,8 @@ def interval_estimates(methods: Dict[str, List[dict]], interim: Optional[str] = 
         panel.set_ylim(len(names) - 0.5, -0.5)
         panel.set_xlabel(xlabel)
         panel.grid(axis="x", alpha=0.3)
-    panels[0].set_xlim(-0.02, 1.02)
+    shown = [r["eval_iqm"] for rows in methods.values() for r in rows if r["eval_iqm"]]
+    panels[0].set_xlim(min([-0.02] + [e["low"] for e in shown]), max([1.02] + [e["high"] for e in shown]))
     panels[1].axvline(0, color="black", linewidth=0.8)
     figure.suptitle("95 % bootstrap intervals (bars) and point estimates (ticks)", fontsize=10)
     legend(panels[0])
@@ -156,18 +160,19 @@ def interval_estimates(methods: Dict[str, List[dict]], interim: Optional[str] = 
 
 
 def performance_profiles(taus: Sequence[float], curves: Dict[str, dict], dashed: Sequence[str] = (),
-                         interim: Optional[str] = None) -> bytes:
-    """Per curve ({"point", "low", "high"} per threshold), the fraction of runs whose success exceeds each
+                         metric: str = "success_once", interim: Optional[str] = None) -> bytes:
+    """Per curve ({"point", "low", "high"} per threshold), the fraction of runs whose `metric` exceeds each
     threshold tau, with its 95 % band; the curves named in `dashed` drawn dashed."""
     figure, ax = new_figure()
     for i, (name, curve) in enumerate(curves.items()):
         colour = {"eval": EVAL_COLOUR, "train": TRAIN_COLOUR}.get(name, METHOD_COLOURS[i % len(METHOD_COLOURS)])
-        ax.plot(taus, curve["point"], color=colour, label=name, linewidth=1.5, linestyle="--" if name in dashed else "-")
+        ax.plot(taus, curve["point"], color=colour, label=name, linewidth=1.5,
+                linestyle="--" if name in dashed else "-")
         ax.fill_between(taus, curve["low"], curve["high"], color=colour, alpha=BAND_ALPHA, linewidth=0)
-    ax.set_xlabel("success threshold τ")
-    ax.set_ylabel("fraction of runs with success > τ")
+    ax.set_xlabel(f"{metric} threshold τ")
+    ax.set_ylabel(f"fraction of runs with {metric} > τ")
     ax.set_ylim(0, 1.05)
-    ax.set_title("performance profile of success (95 % bands)", fontsize=10)
+    ax.set_title(f"performance profile of {metric} (95 % bands)", fontsize=10)
     ax.grid(alpha=0.3)
     legend(ax)
     return png_bytes(figure, interim)

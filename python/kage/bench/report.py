@@ -27,9 +27,9 @@ original code does not compute it (§5.4). The drop is undefined (null in JSON, 
 Markdown) where the train mean is 0. `max_abs_diff` is the original's own gap measure: per run, the largest
 |train - eval| at a single evaluation point, then averaged like any other value.
 
-Beside these, interval estimates of success (kage.bench.intervals, after rliable): per axis and over all plain
-pairs, the IQM of eval and train success with 95 % stratified-bootstrap intervals and the drop with a paired
-ratio bootstrap, and the performance profile of eval success.
+Beside these, interval estimates of success (kage.bench.intervals, after rliable; of progress or success with
+`metric`): per axis and over all plain pairs, the IQM of eval and train success with 95 % stratified-bootstrap
+intervals and the drop with a paired ratio bootstrap, and the performance profile of eval success.
 
 Only finished runs (with summary.json) enter the tables; unfinished ones are counted and listed. With `partial`
 (--partial), unfinished runs enter too, scored over the evaluation points they have logged (their maximum, or
@@ -330,6 +330,7 @@ def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "ma
                 per_run.append(values)
             results[pair["pair"]] = {
                 "pair": pair["pair"], "axis": pair["declared_axis"], "certified": pair.get("certified"),
+                "train_spec": pair["train"].get("spec_sha256", pair["train"].get("name")),
                 "n_seeds": len(included), "seeds": [r.seed for r in included], "metrics": over_seeds(per_run)}
         if not unit.is_sweep:
             pairs.extend(results[p["pair"]] for p in unit.pairs)
@@ -430,10 +431,10 @@ def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], lev
         drops = [a["metrics"][SUCCESS_SHOWN]["drop_pct"] for a in levels["axes"]]
         figures["plots/drop_per_axis.png"] = plots.drop_per_axis([a["axis"] for a in levels["axes"]], drops, interim)
     if estimates and estimates["profile"]:
-        figures["plots/intervals.png"] = plots.interval_estimates({"": estimates["rows"]}, interim)
-        profile = estimates["profile"]
-        figures["plots/profile_success.png"] = plots.performance_profiles(
-            profile["taus"], {"eval": profile["eval"], "train": profile["train"]}, dashed={"train"}, interim=interim)
+        metric, profile = estimates["metric"], estimates["profile"]
+        figures["plots/intervals.png"] = plots.interval_estimates({"": estimates["rows"]}, metric, interim)
+        figures[f"plots/profile_{metric}.png"] = plots.performance_profiles(
+            profile["taus"], {"eval": profile["eval"], "train": profile["train"]}, {"train"}, metric, interim)
     for s in levels["sweeps"]:
         figures[f"plots/sweep_{safe(s['sweep'])}.png"] = plots.sweep_response(
             f"{s['sweep']} ({s['axis']})", [e["sweep_eval"] for e in s["evals"]],
@@ -458,12 +459,14 @@ def read_benchmark(bench_dir: str) -> Tuple[dict, dict, List[Unit], Dict[str, Li
 
 
 def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
-           reps: int = intervals.REPS, partial: bool = False) -> dict:
+           reps: int = intervals.REPS, partial: bool = False, metric: str = SUCCESS_SHOWN) -> dict:
     """Reads the benchmark directory `bench_dir`, writes the tables, plots and report.json into `out_dir`
     (default bench_dir/report, report_final under `protocol` "final", with "_interim" appended under `partial`)
-    and returns report.json's content. `reps`: bootstrap resamples of the interval estimates."""
+    and returns report.json's content. `reps`: bootstrap resamples of the interval estimates of `metric`."""
     if protocol not in PROTOCOLS:
         fail(f"unknown protocol '{protocol}': choose {' or '.join(PROTOCOLS)}")
+    if metric not in intervals.METRICS:
+        fail(f"the interval estimates take {', '.join(intervals.METRICS)}, not '{metric}'")
     suite, bench, units, runs = read_benchmark(bench_dir)
     out_dir = out_dir or os.path.join(bench_dir, ("report" if protocol == "max" else "report_final")
                                       + ("_interim" if partial else ""))
@@ -485,7 +488,8 @@ def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
         },
         "metrics": list(METRICS), "markdown_success_column": SUCCESS_SHOWN,
         "runs_found": status, "interim": interim_line(status), "levels": levels,
-        "intervals": intervals.interval_report(levels["runs"], levels["pairs"], reps) if levels["pairs"] else None,
+        "intervals": intervals.interval_report(levels["runs"], levels["pairs"], reps, metric) if levels["pairs"]
+        else None,
     }
     try:
         write_report(out_dir, result, units, runs)

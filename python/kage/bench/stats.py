@@ -16,13 +16,16 @@ with replacement, and a percentile interval is read off the resamples' statistic
 never resampled themselves: the interval says how much the result would move with other seeds on the same
 tasks. Two choices differ from rliable's:
 - Shared runs (`groups`). rliable resamples every task on its own, which is right when each task's runs are
-  separate trainings: `kage.bench run` without --share-training, where seed s of two pairs is two trainings.
-  Under --share-training one run per (train config, seed) is evaluated on every pair of that train config, so
+  independent trainings. Under --share-training one run per (train config, seed) is evaluated on every pair of
+  that train config (and without it, each pair's own run of that config and seed trains the same agent), so
   those pairs' scores come from the same trainings and move together; resampling them separately would
   average that shared luck away and give intervals too narrow. `groups` gives each task a label; tasks with the
   same label share runs (row i is the same run in each, NaN in all of them where it is missing) and are
-  resampled with one draw of rows. None, the default, is one group per task: rliable's bootstrap.
-  `kage.bench report` passes, per pair, the run unit that trained it (the pair itself, or its shared run).
+  resampled with one draw of rows. None, the default, is one group per task: rliable's bootstrap. Resampling
+  independent tasks together is still a valid bootstrap (of the rows as vectors), so a group declared where the
+  runs turn out independent costs little. `kage.bench report` groups the pairs by train config: a run depends
+  only on its train config, seed and flags, so the pairs of one train config have the same runs even when each
+  pair trained its own.
 - Reproducibility. rliable draws its resamples from numpy's global generator, so its `random_state` does not
   fix them. Here every call builds its own `numpy.random.Generator` from `seed` (and, in `interval_estimates`,
   from each name, so that a method's interval does not depend on which other methods are in the dict): the

@@ -2,7 +2,7 @@
 and their files (see its docstring for the protocol). Numbers in Markdown: mean ± SEM to 3 significant
 digits (at most 2 decimals); "-" where a value is missing, "n/a" for an undefined drop."""
 import os
-from typing import List, Optional, Sequence
+from typing import List, Optional
 
 from kage.bench.interval_tables import intervals_csv, md_intervals
 from kage.util.files import atomic_write
