@@ -52,9 +52,12 @@ struct DTypeFacts {
   const char* typestr;
   size_t bytes;
 };
+// DLPack's bool type code (kDLBool, DLPack 0.8); Debian's dlpack.h is 0.6, which lacks the name.
+constexpr auto kDLPackBool = static_cast<DLDataTypeCode>(6);
 constexpr DTypeFacts kDTypes[] = {
-    {{kDLUInt, 8, 1}, "|u1", 1}, {{kDLInt, 32, 1}, "<i4", 4}, {{kDLInt, 64, 1}, "<i8", 8}, {{kDLFloat, 32, 1}, "<f4", 4}};
-static_assert(std::size(kDTypes) == static_cast<size_t>(kage::DType::kFloat32) + 1, "a DType without facts");
+    {{kDLUInt, 8, 1}, "|u1", 1},  {{kDLInt, 32, 1}, "<i4", 4}, {{kDLInt, 64, 1}, "<i8", 8},
+    {{kDLFloat, 32, 1}, "<f4", 4}, {{kDLPackBool, 8, 1}, "|b1", 1}};
+static_assert(std::size(kDTypes) == static_cast<size_t>(kage::DType::kBool) + 1, "a DType without facts");
 
 const DTypeFacts& facts(kage::DType t) { return kDTypes[static_cast<size_t>(t)]; }
 py::dtype numpy_dtype(kage::DType t) { return py::dtype(facts(t).typestr); }
@@ -384,12 +387,10 @@ class PyEnv {
     } else if (name == "reward") {
       l.data = env.reward();
       l.dtype = kage::DType::kFloat32;
-    } else if (name == "terminated") {
-      l.data = env.terminated();
-    } else if (name == "truncated") {
-      l.data = env.truncated();
-    } else if (name == "final_mask") {
-      l.data = env.final_mask();
+    } else if (name == "terminated" || name == "truncated" || name == "final_mask") {
+      // Bool, as Gymnasium's flags and masks are: a uint8 0/1 mask would index rows 0 and 1 instead of masking.
+      l.dtype = kage::DType::kBool;
+      l.data = name == "terminated" ? env.terminated() : name == "truncated" ? env.truncated() : env.final_mask();
     } else {
       const bool final = name.rfind("final_info/", 0) == 0;
       const std::string field = name.substr(name.find('/') + 1);

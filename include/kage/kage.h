@@ -40,7 +40,7 @@ enum class Backend {
 enum class Memory { kHost, kDevice };
 
 /// Element types of the arrays of this API.
-enum class DType { kUInt8, kInt32, kInt64, kFloat32 };
+enum class DType { kUInt8, kInt32, kInt64, kFloat32, kBool };  ///< kBool: one byte, 0 or 1
 
 struct Options {
   Backend backend = Backend::kCpu;
@@ -129,8 +129,8 @@ class Env {
   /// values) on the GPU backend. Valid until the next call.
   virtual const uint8_t* obs() const = 0;         ///< [N][H][W][3] uint8, row-major
   virtual const float* reward() const = 0;        ///< [N]
-  virtual const uint8_t* terminated() const = 0;  ///< [N] 0/1
-  virtual const uint8_t* truncated() const = 0;   ///< [N] 0/1
+  virtual const uint8_t* terminated() const = 0;  ///< [N] 0/1 (DType::kBool)
+  virtual const uint8_t* truncated() const = 0;   ///< [N] 0/1 (DType::kBool)
   /// [N] values of one info field (element type from info_fields()), of the state after the call: for
   /// an environment that was reset by the step, the new episode's.
   virtual const void* info(InfoField field) const = 0;

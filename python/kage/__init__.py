@@ -7,9 +7,13 @@ The package has three layers, each importing only those below it:
 - ``kage.bench``: the benchmark runner (``python3 -m kage.bench run|report|score|status|slurm|speed``).
 
 Importing ``kage`` loads neither torch nor the compiled extension: names below load what they need on
-first use.
+first use. Where Gymnasium is importable, it registers ``kage/KAGE-v0`` with it (``kage.registration``).
 """
 import importlib
+
+from kage.registration import register_with_gymnasium
+
+register_with_gymnasium()  # gymnasium.make("kage/KAGE-v0", ...), where Gymnasium is importable
 
 # name -> the module that defines it (loaded on first access, PEP 562).
 _LAZY = {

@@ -1,13 +1,18 @@
-"""The observation and action spaces: Gymnasium's when it is importable, else objects with the same
-``shape``, ``dtype``, ``n``, ``low``, ``high``, ``sample()`` and ``contains()``."""
+"""The observation and action spaces and the autoreset mode: Gymnasium's when it is importable, else objects
+with the same ``shape``, ``dtype``, ``n``, ``low``, ``high``, ``sample()`` and ``contains()``, and the mode's
+value."""
 from typing import Optional, Tuple
 
 import numpy as np
 
 try:  # pragma: no cover - depends on the interpreter
     from gymnasium import spaces as _gym_spaces
+    from gymnasium.vector import AutoresetMode
 except ImportError:
-    _gym_spaces = None
+    _gym_spaces = AutoresetMode = None
+
+#: VecEnv's autoreset mode: Gymnasium's enum where it is importable, else its value.
+SAME_STEP = AutoresetMode.SAME_STEP if AutoresetMode is not None else "SameStep"
 
 
 class Box:

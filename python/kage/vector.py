@@ -85,15 +85,19 @@ class VecEnv:
 
     ``reset(seed=None, options=None) -> (obs, info)`` and
     ``step(actions) -> (obs, reward, terminated, truncated, info)``: obs uint8 [N, H, W, 3], reward
-    float32 [N], terminated and truncated uint8 0/1 [N] (``.astype(bool)`` / ``.bool()``: DLPack 0.6,
-    numpy 1.24 and torch 1.13 share no bool type), info a dict of [N] arrays named as the original's
+    float32 [N], terminated and truncated bool [N], info a dict of [N] arrays named as the original's
     info (``x``, ``y``, ``vx``, ``vy``, ``vx_mean``, ``vy_mean``, ``timestep``, ``passed_distance``,
     ``progress``, ``success``, ``success_once``, ``jump_count``, ``return``, ``length``).
 
     Same-step autoreset: when a step ends an episode, that environment starts its next episode in the
     same step. The step returns the finishing step's reward and flags, the new episode's first
     observation and info, and the finished episode in ``info["final_obs"]`` and ``info["final_info"]``
-    (a dict of the same fields), where ``info["_final"]`` is 1. Rows where ``_final`` is 0 are stale.
+    (a dict of the same fields), where the bool mask ``info["_final"]`` is true (so ``final_obs[info["_final"]]``
+    selects the finished rows). Rows where ``_final`` is false hold an earlier episode's end, or zeros.
+
+    Gymnasium: ``metadata["autoreset_mode"]`` is ``gymnasium.vector.AutoresetMode.SAME_STEP`` where Gymnasium
+    is importable; ``gymnasium.make_vec("kage/KAGE-v0", ...)`` returns this class (``kage.registration``) and
+    sets ``spec`` to its ``EnvSpec``. The batch's resolved Spec is ``resolved_spec``.
 
     Threads: a batch may be used from any thread, and calls from several threads run one at a time, each
     one whole (a step's state is never torn, ``save_state`` never sees half a step). ``close()`` (and
@@ -103,7 +107,9 @@ class VecEnv:
     On the GPU, closing waits for the device's queued work before the batch's memory is freed.
     """
 
-    metadata = {"autoreset_mode": "same-step"}
+    metadata = {"autoreset_mode": spaces.SAME_STEP}
+    spec = None  # Gymnasium's EnvSpec, where gymnasium.make_vec made the batch
+    render_mode = None
 
     def __init__(self, handle: "kage._kage.Env", config: str, seed: int, asset_root: Optional[str] = None):
         self._handle = handle
@@ -226,6 +232,11 @@ class VecEnv:
     def stream(self) -> int:
         """The CUstream handle the batch queues its work on (0: the legacy default stream)."""
         return self._live().stream
+
+    @property
+    def unwrapped(self) -> "VecEnv":
+        """This batch (Gymnasium's wrappers reach the environment through it)."""
+        return self
 
     @property
     def resolved_spec(self) -> dict:

@@ -12,7 +12,7 @@ def test_shapes_and_dtypes():
         assert obs.shape == (3, 128, 128, 3) and obs.dtype == np.uint8
         obs, reward, terminated, truncated, info = env.step(np.array([2, 6, 0]))
         assert reward.shape == (3,) and reward.dtype == np.float32
-        assert terminated.dtype == np.uint8 and truncated.dtype == np.uint8
+        assert terminated.dtype == bool and truncated.dtype == bool
         expected = {name: dtype for name, dtype, _ in kage.INFO_FIELDS}
         assert set(expected) == {"x", "y", "vx", "vy", "vx_mean", "vy_mean", "timestep", "passed_distance",
                                  "progress", "success", "success_once", "jump_count", "return", "length"}
@@ -20,7 +20,7 @@ def test_shapes_and_dtypes():
             assert info[name].shape == (3,) and info[name].dtype == dtype, name
         assert info["final_obs"].shape == (3, 128, 128, 3)
         assert set(info["final_info"]) == set(expected)
-        assert info["_final"].dtype == np.uint8 and not info["_final"].any()
+        assert info["_final"].dtype == bool and not info["_final"].any()
         assert info["timestep"].tolist() == [1, 1, 1] and info["length"].tolist() == [1, 1, 1]
         assert obs.any(), "the frame is not blank"
 
@@ -28,7 +28,7 @@ def test_shapes_and_dtypes():
 def test_spaces_and_metadata():
     with kage.make_vec(SIMPLEST, 2) as env:
         assert env.num_envs == 2
-        assert env.metadata["autoreset_mode"] == "same-step"
+        assert env.metadata["autoreset_mode"].value == "SameStep"  # gymnasium.vector.AutoresetMode.SAME_STEP
         assert env.single_observation_space.shape == (128, 128, 3)
         assert env.single_observation_space.dtype == np.uint8
         assert env.single_action_space.n == 8

@@ -1,0 +1,72 @@
+"""One KAGE environment with Gymnasium's single-environment API, for ``gymnasium.make("kage/KAGE-v0",
+config=...)``: a view of a batch of one (``kage.make_vec(config, 1)``) that copies what it returns, so the
+arrays stay valid after the next step, as Gymnasium's checks expect.
+
+Episode ends: the runtime resets an environment in the step that ends its episode (same-step autoreset).
+This view hides that: the step that ends an episode returns that episode's last observation and info, with
+``terminated`` or ``truncated`` true, as Gymnasium's API says. Then ``reset()`` without a seed returns the
+first observation of the episode the runtime already started in that step (its randomness comes from the
+environment's own seed stream, as in ``kage.make_vec``); ``reset(seed=s)`` starts afresh from ``s``.
+Stepping on after an episode's end without ``reset()`` continues that new episode (Gymnasium's
+PassiveEnvChecker warns about it).
+"""
+from typing import Any, Dict, Optional, Tuple
+
+import gymnasium
+import numpy as np
+
+from kage.vector import make_vec
+
+
+class SingleEnv(gymnasium.Env):
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 60}  # a step is dt = 1/60 s of game time (spec)
+
+    def __init__(self, config: str, device: str = "cpu", render_mode: Optional[str] = "rgb_array",
+                 asset_root: Optional[str] = None):
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode={render_mode!r}: KAGE renders 'rgb_array' frames only")
+        self.render_mode = render_mode
+        self._batch = make_vec(config, 1, device=device, asset_root=asset_root, threads=1)
+        self.observation_space = self._batch.single_observation_space
+        self.action_space = self._batch.single_action_space
+        self._frame: Optional[np.ndarray] = None
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None
+              ) -> Tuple[np.ndarray, Dict[str, Any]]:
+        super().reset(seed=seed)
+        if options:
+            raise ValueError(f"reset: unknown options {sorted(options)} (a single environment takes none)")
+        if seed is not None or self._frame is None:
+            obs, info = self._batch.reset(seed=seed)
+            return self._keep(obs[0]), _row(info)
+        # The runtime started the next episode in the step that ended the last one: return its start.
+        obs, _, _, _, info = self._batch.outputs()
+        return self._keep(obs[0]), _row(info)
+
+    def step(self, action) -> Tuple[np.ndarray, float, bool, bool, Dict[str, Any]]:
+        if not self.action_space.contains(action):
+            raise ValueError(f"action {action!r}: an integer in 0..{self.action_space.n - 1}")
+        obs, reward, terminated, truncated, info = self._batch.step(np.array([action], dtype=np.int32))
+        if bool(np.asarray(info["_final"])[0]):  # the episode ended: show its end, not the next start
+            obs, fields = info["final_obs"], info["final_info"]
+        else:
+            fields = info
+        return (self._keep(obs[0]), float(reward[0]), bool(terminated[0]), bool(truncated[0]), _row(fields))
+
+    def render(self) -> Optional[np.ndarray]:
+        """The last observation returned, [H, W, 3] uint8 (render_mode "rgb_array"), or None."""
+        return None if self.render_mode is None or self._frame is None else self._frame.copy()
+
+    def close(self) -> None:
+        self._batch.close()
+
+    def _keep(self, frame) -> np.ndarray:
+        self._frame = np.array(frame, copy=True)
+        return self._frame.copy()
+
+
+def _row(info: Dict[str, Any]) -> Dict[str, Any]:
+    """Row 0 of a batch's info fields, as Python scalars."""
+    from kage.vector import INFO_FIELDS
+
+    return {name: np.asarray(info[name])[0].item() for name, _, _ in INFO_FIELDS}

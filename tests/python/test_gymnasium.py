@@ -1,0 +1,84 @@
+"""kage with the real Gymnasium 1.x: the registered vector and single environments, Gymnasium's own spaces, its
+autoreset mode, its environment checker on the single environment, and bool flags and masks that index as
+masks. Gymnasium's checks that do not apply are listed in README ("Gymnasium")."""
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+from gymnasium.vector import AutoresetMode
+
+import kage
+from support import NOISY_SKELETON, SIMPLEST
+
+
+def test_make_vec_returns_the_project_vector_environment():
+    env = gymnasium.make_vec("kage/KAGE-v0", num_envs=3, vectorization_mode="vector_entry_point", config=SIMPLEST)
+    try:
+        assert isinstance(env, kage.VecEnv) and env.num_envs == 3
+        assert env.metadata["autoreset_mode"] is AutoresetMode.SAME_STEP
+        assert env.spec is not None and env.spec.id == "kage/KAGE-v0" and env.spec.kwargs["config"] == SIMPLEST
+        assert isinstance(env.single_observation_space, gymnasium.spaces.Box)
+        assert isinstance(env.single_action_space, gymnasium.spaces.Discrete) and env.single_action_space.n == 8
+        obs, info = env.reset(seed=5)
+        assert obs.shape == (3, *env.single_observation_space.shape)
+        assert all(env.single_observation_space.contains(o) for o in obs)
+        obs, reward, terminated, truncated, info = env.step(np.array([1, 2, 4]))
+        assert reward.dtype == np.float32 and terminated.dtype == bool and truncated.dtype == bool
+        assert info["_final"].dtype == bool and not info["_final"].any()
+    finally:
+        env.close()
+
+
+def test_flags_and_masks_are_bool_and_index_as_masks():
+    env = kage.make_vec(NOISY_SKELETON, 4)
+    try:
+        env.reset(seed=1)
+        rng = np.random.default_rng(0)
+        for _ in range(10):
+            env.step(rng.integers(0, 8, 4))
+        # Environments 0 and 2 start again, 10 steps behind 1 and 3, whose episodes (40 steps) end first.
+        env.reset(options={"reset_mask": np.array([True, False, True, False])})
+        assert not env.outputs()[4]["_final"].any()
+        for _ in range(40):
+            obs, reward, terminated, truncated, info = env.step(rng.integers(0, 8, 4))
+            if info["_final"].any():
+                break
+        final = info["_final"]
+        assert final.dtype == bool and terminated.dtype == bool and truncated.dtype == bool
+        assert final.tolist() == [False, True, False, True]
+        # A bool mask selects the finished rows; the uint8 0/1 masks of before indexed rows 0 and 1 instead.
+        chosen = info["final_obs"][final]
+        assert chosen.shape == (int(final.sum()), *env.single_observation_space.shape)
+        assert np.array_equal(chosen, info["final_obs"][np.flatnonzero(final)])
+        assert np.array_equal(final, terminated | truncated)
+    finally:
+        env.close()
+
+
+def test_the_single_environment_passes_gymnasiums_checker():
+    env = gymnasium.make("kage/KAGE-v0", config=SIMPLEST)
+    try:
+        check_env(env.unwrapped, skip_render_check=False)
+    finally:
+        env.close()
+
+
+def test_the_single_environment_ends_an_episode_as_gymnasium_says():
+    env = gymnasium.make("kage/KAGE-v0", config=SIMPLEST, disable_env_checker=True)
+    try:
+        obs, info = env.reset(seed=3)
+        assert obs.shape == (128, 128, 3) and info["timestep"] == 0
+        steps, done = 0, False
+        while not done:
+            obs, reward, terminated, truncated, info = env.step(2)
+            steps += 1
+            done = terminated or truncated
+        # Episodes end by truncation at episode_length; the step shows the ended episode, not the next start.
+        assert truncated and not terminated and steps == 500 and info["timestep"] == 500
+        assert np.array_equal(env.render(), obs)
+        obs, info = env.reset()
+        assert info["timestep"] == 0 and info["return"] == 0
+        with pytest.raises(ValueError, match="0..7"):
+            env.step(8)
+    finally:
+        env.close()
