@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
-# Installs what is missing (Debian packages), then configures and builds kagec
-# and its tests into ./build. Safe to run again: it only does what is needed.
+# Installs what is missing (Debian packages, and the Python test environment .venv: scripts/venv.sh),
+# then builds kagec, the Python package and the tests into ./build by installing the project into .venv
+# with pip (scikit-build-core): the installed package and CTest share that one build folder, which is
+# built incrementally. Safe to run again.
+#   KAGE_CUDA=AUTO|ON|OFF  the CUDA backend (default AUTO: built where nvcc and NVRTC's header are found)
+#   BUILD=DIR              the build folder (default build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(build-essential cmake ninja-build pkg-config
-          libyaml-cpp-dev nlohmann-json3-dev libfmt-dev libstb-dev catch2 libcli11-dev
-          python3-jsonschema python3-yaml clang libclang-rt-14-dev
-          python3-dev pybind11-dev libdlpack-dev python3-numpy python3-pytest python3-torch python3-matplotlib
-          python3-pil slurm-wlm munge)  # pil: GIF videos; slurm-wlm, munge: the kage.bench job-array test starts a one-node Slurm cluster
+packages=(build-essential cmake ninja-build pkg-config ccache
+          libyaml-cpp-dev nlohmann-json3-dev libfmt-dev libstb-dev catch2 libcli11-dev libdlpack-dev
+          clang libclang-rt-14-dev  # the fuzzer (tests/fuzz)
+          slurm-wlm munge)          # the kage.bench job-array test starts a one-node Slurm cluster
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -21,10 +24,19 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq "${missing[@]}" >/dev/null
 fi
 
-# The CUDA toolkit is optional: with it, the GPU code is compiled (and checked) too.
+# The CUDA toolkit is optional: with it (and NVRTC's header, which the venv's nvidia-cuda-nvrtc wheel
+# carries), the GPU backend is compiled and checked too.
 if [[ -z ${CUDACXX:-} && -x /usr/local/cuda/bin/nvcc ]]; then export CUDACXX=/usr/local/cuda/bin/nvcc; fi
-
-# The Python package is built for Debian's interpreter, the one that has the python3-* packages above
-# (a python3 earlier on PATH may be another one).
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build build -j"$(nproc)"
+python=$(scripts/venv.sh)
+build=${BUILD:-build}
+# ccache shares object files between build folders (build/, the KAGE_CUDA=OFF build, a fresh clone's).
+if command -v ccache >/dev/null; then
+  export CMAKE_CXX_COMPILER_LAUNCHER=ccache CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=1
+fi
+export CMAKE_BUILD_PARALLEL_LEVEL=$(nproc)
+# No build isolation: the venv's pinned scikit-build-core and pybind11 build it, and the build folder's
+# paths stay the same from one run to the next.
+"$python" -m pip install -q --no-build-isolation -C build-dir="$build" -C cmake.build-type=RelWithDebInfo \
+  -C cmake.define.KAGE_BUILD_TESTS=ON -C cmake.define.KAGE_CUDA="${KAGE_CUDA:-AUTO}" .
+"$python" -c 'import kage; print(f"build.sh: kage {kage.__version__} installed into .venv, GPU backend built: "
+                                 f"{kage.gpu_backend_built()}; build folder '"$build"'")'

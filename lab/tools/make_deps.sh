@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Fills .deps (ignored by git) with what a build on the device machine needs and that machine lacks:
-# the Debian packages of yaml-cpp, fmt, stb, nlohmann-json, CLI11 and dlpack, unpacked, and Python
-# 3.12's headers (from pyenv, if present). Carry it: run's carry [".deps"].
+# the Debian packages of yaml-cpp, fmt, stb, nlohmann-json, CLI11 and dlpack, unpacked, Python 3.12's
+# headers (from pyenv, if present), and in .deps/wheels the build backend that `pip install .` needs
+# there without an index (scikit-build-core, pure Python). Carry it: run's carry [".deps"].
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 rm -rf .deps && mkdir -p .deps/debs
@@ -12,4 +13,5 @@ rm -rf .deps/debs
 if [ -d /root/.pyenv/versions/3.12.1/include/python3.12 ]; then
   mkdir -p .deps/python3.12/include && cp -r /root/.pyenv/versions/3.12.1/include/python3.12 .deps/python3.12/include/
 fi
+python3 -m pip download -q --no-deps -d .deps/wheels scikit-build-core==1.1.2 pathspec==1.1.1 packaging==26.4
 du -sh .deps
