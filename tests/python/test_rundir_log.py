@@ -4,10 +4,11 @@ import json
 import math
 
 from kage.ppo.rundir import RunDir
+from kage.util.lock import DirectoryLock
 
 
 def test_non_finite_values_are_logged_as_null(tmp_path, capsys):
-    run = RunDir(str(tmp_path), {})
+    run = RunDir(str(tmp_path), {}, DirectoryLock(str(tmp_path), "run", "test"))
     run.log({"kind": "train", "iteration": 7, "losses/loss": math.nan, "losses/value_loss": math.inf,
              "losses/entropy": 0.5})
     run.log({"kind": "train", "iteration": 8, "losses/loss": math.nan, "losses/entropy": 0.25})

@@ -14,7 +14,7 @@ import time
 from typing import List
 
 from kage.bench import tasks
-from kage.util.stop import stop_children
+from kage.util.stop import child_environment, stop_children
 
 FAKE_GPUS = "KAGE_BENCH_FAKE_GPUS"
 
@@ -76,7 +76,7 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
                 print(f"[gpu {device}] task {index}: {tasks.describe(table[index])}", file=sys.stderr, flush=True)
                 log = open(os.path.join(log_dir, f"task_{index}.log"), "ab")
                 children[device] = subprocess.Popen([*bench.run_command(), "--task", str(index)], stdout=log,
-                                                    stderr=log, env={**os.environ, "CUDA_VISIBLE_DEVICES": device})
+                                                    stderr=log, env=child_environment(CUDA_VISIBLE_DEVICES=device))
             code = children[device].wait()
             log.close()
             with lock:

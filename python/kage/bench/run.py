@@ -17,12 +17,15 @@ seed, in one run that evaluates all their eval configs (the 34 pairs of KAGE-Ben
     DIR/packs/pack_<i>.json, .log   under --pack: the runs one process trained together, and its log
                                     (task_<I>_pack_<i> under --task I)
     DIR/tasks/task_<I>.log          under --gpus: the log of task I's process
+    DIR/bench.lock                  while a runner of all tasks (or --gpus) writes DIR; DIR/tasks/task_<I>.lock
+                                    while `--task I` does (kage.util.lock: host, process, start)
 
 A plain pair trains on its train config and evaluates on its eval config (label "eval"). A sweep (one
 train config, several evals) runs once per seed and evaluates every eval config of the sweep (labels:
 the evals' names). Running again on the same DIR skips finished runs, resumes unfinished ones from their
 checkpoints, and never overwrites a result; it refuses other trainer flags, and a config whose Spec
-changed since DIR was started.
+changed since DIR was started. One runner writes DIR (or, with --task, one task of it) at a time: a second
+one refuses at once, naming the first. A runner's trainers stop when it ends, however it ends.
 """
 import argparse
 import dataclasses
@@ -41,7 +44,8 @@ from kage.bench import gpus, run_state, tasks
 from kage.bench.units import Unit, select, units_of
 from kage.errors import ConfigError
 from kage.util.files import atomic_write, remove_strays, write_json
-from kage.util.stop import stop_children
+from kage.util.lock import DirectoryLock, LockHeld
+from kage.util.stop import child_environment, die_with_parent, stop_children
 
 
 def parse_seeds(text: str) -> List[int]:
@@ -240,6 +244,7 @@ class Bench:
     steps_per_run: int
     device: str
     share_training: bool
+    report: dict = dataclasses.field(default_factory=dict, repr=False)  # the suite's (kagec suite)
 
     def table(self) -> List[List[tasks.Job]]:
         return tasks.task_table(self.units, self.seeds, self.pack, self.out)
@@ -264,9 +269,14 @@ def add_bench_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
-    """Checks the arguments, the trainer flags and the suite, then records the benchmark in args.out
-    (suite.json, bench.json, tasks.json). The suite and DIR are named by absolute paths from here on, so
-    that every process of the benchmark resolves the same configs wherever it starts."""
+    """plan(), then record()."""
+    return record(plan(args, trainer_args))
+
+
+def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
+    """Checks the arguments, the trainer flags and the suite, writing nothing. The suite and DIR are named by
+    absolute paths from here on, so that every process of the benchmark resolves the same configs wherever it
+    starts."""
     if args.pack < 1:
         raise SystemExit(f"kage.bench: --pack {args.pack}: a positive number of runs per process")
     for flag in ("--train-config-path", "--eval-config-path", "--eval-config-paths", "--eval-config-labels",
@@ -291,17 +301,54 @@ def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
     for p in report["pairs"]:
         if not p["certified"] and any(p["pair"] == q["pair"] for u in units for q in u.pairs):
             print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
+    return Bench(suite, out, args.seeds, args.pairs, args.pack, trainer_args, units, seeds,
+                 probe.num_iterations * probe.batch_size, probe.device, args.share_training, report)
 
+
+def record(bench: Bench) -> Bench:
+    """Records the benchmark in its DIR (suite.json, bench.json, tasks.json), refusing a DIR started on other
+    flags or on configs that changed since."""
+    out = bench.out
     os.makedirs(out, exist_ok=True)
     for folder in ("", "packs", "slurm"):
         remove_strays(os.path.join(out, folder))  # dead writers' temporary files (run directories: the trainer's)
-    check_suite_unchanged(out, report)
-    record_bench(out, suite, seeds, units, trainer_args, args.share_training)
-    write_json(os.path.join(out, "suite.json"), report)
-    bench = Bench(suite, out, args.seeds, args.pairs, args.pack, trainer_args, units, seeds,
-                  probe.num_iterations * probe.batch_size, probe.device, args.share_training)
-    tasks.write_task_table(out, bench.table(), args.pack)
+    check_suite_unchanged(out, bench.report)
+    record_bench(out, bench.suite, bench.seeds, bench.units, bench.trainer_args, bench.share_training)
+    write_json(os.path.join(out, "suite.json"), bench.report)
+    tasks.write_task_table(out, bench.table(), bench.pack)
     return bench
+
+
+BENCH_LOCK_ENV = "KAGE_BENCH_LOCK"  # a runner's bench.lock token, which lets its own --task children run
+
+
+def lock_bench(out: str, task: Optional[int]) -> DirectoryLock:
+    """The runner's lock on DIR: bench.lock for a runner of all tasks (refused while a --task process of DIR
+    runs), tasks/task_<I>.lock for --task I (refused while another runner holds bench.lock)."""
+    way_out = f"Wait for it to end or stop it (python3 -m kage.bench status {out}), or use another --out"
+    os.makedirs(os.path.join(out, "tasks"), exist_ok=True)
+    try:
+        if task is not None:
+            whole = DirectoryLock(out, "bench", "kage.bench run")
+            holder = whole.read()
+            if holder is not None and holder.get("token") != os.environ.get(BENCH_LOCK_ENV) and whole.alive(holder):
+                raise LockHeld(whole.describe(holder, way_out))
+            held = DirectoryLock(os.path.join(out, "tasks"), f"task_{task}", f"kage.bench run --task {task}")
+            held.acquire(way_out)
+            return held
+        held = DirectoryLock(out, "bench", "kage.bench run")
+        held.acquire(way_out)
+        for name in sorted(os.listdir(os.path.join(out, "tasks"))):
+            if name.startswith("task_") and name.endswith(".lock"):
+                one = DirectoryLock(os.path.join(out, "tasks"), name[:-len(".lock")], "")
+                holder = one.read()
+                if holder is not None and one.alive(holder):
+                    held.release()
+                    raise LockHeld(one.describe(holder, way_out))
+        os.environ[BENCH_LOCK_ENV] = held.token
+        return held
+    except LockHeld as e:
+        raise SystemExit(f"kage.bench run: {e}") from None
 
 
 def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Optional[int]) -> int:
@@ -330,7 +377,7 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
         with open(log_path, "ab") as log:
             # Its own session: a terminal's Ctrl-C or a kill of our process group reaches it through stop_children.
             child = subprocess.Popen([sys.executable, "-m", "kage.ppo.train", *command], stdout=log, stderr=log,
-                                     start_new_session=True)
+                                     start_new_session=True, env=child_environment())
             try:
                 beat = time.monotonic()
                 while child.poll() is None:
@@ -371,10 +418,20 @@ def main(argv: List[str]) -> int:
     parser.add_argument("--gpus", help="'all' or a list like 0,2: one worker process per GPU, each training "
                                        "tasks until none is left")
     args, trainer_args = parser.parse_known_args(argv)
+    die_with_parent()  # a --task worker of --gpus stops with its runner
     if args.task is not None and args.gpus:
         raise SystemExit("kage.bench run: --task and --gpus exclude each other: --gpus runs the tasks itself")
-    bench = prepare(args, trainer_args)
+    bench = plan(args, trainer_args)
     devices = gpus.parse_gpus(args.gpus, bench.device) if args.gpus else None
+    held = lock_bench(bench.out, args.task)
+    try:
+        return run_locked(record(bench), args, devices)
+    finally:
+        held.release()
+
+
+def run_locked(bench: Bench, args: argparse.Namespace, devices: Optional[List[str]]) -> int:
+    """main() under the runner's lock."""
     table = bench.table()
     signal.signal(signal.SIGTERM, raise_stop)
     if devices:

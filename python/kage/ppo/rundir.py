@@ -7,13 +7,15 @@
     DIR/checkpoints/latest.pt    parameters, optimizer, random streams, environments' state, loop state: data
                                  only (kage.ppo.checkpoint), never unpickled
     DIR/summary.json             at the end: min, mean, median and max of every evaluated value (§3.4)
+    DIR/run.lock                 while a trainer writes the directory: its host, process and start (kage.util.lock)
 
 Nothing is lost when the process is killed: files are replaced atomically (written beside, then
 renamed), log rows are flushed and synced one by one, and a rerun with the same arguments resumes from
 the checkpoint, dropping the log rows written after it, so the log has no gap and no duplicate. A
 finished run (summary.json) is never touched again; a config whose Spec changed since the run started is
-refused.
+refused. One trainer writes a run directory at a time: a second one refuses at once, naming the first.
 """
+import contextlib
 import dataclasses
 import json
 import math
@@ -29,6 +31,7 @@ import torch
 from kage import front_end, resources
 from kage.ppo import checkpoint, plugins
 from kage.util.files import atomic_write, remove_strays, safe, write_json
+from kage.util.lock import DirectoryLock, LockHeld
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
 # Arguments added since runs were first written, with the value that means what a run without them did.
@@ -62,52 +65,66 @@ def default_dir(args) -> str:
     return os.path.join("runs", f"{args.exp_name}__{stem}__{args.seed}")
 
 
+def is_finished(path: str) -> bool:
+    return os.path.exists(os.path.join(path, "summary.json"))
+
+
+_held: List["RunDir"] = []  # the run directories this process has open, in opening order
+
+
+@contextlib.contextmanager
+def held_open():
+    """Closes (and unlocks) the run directories opened inside the block, however it ends."""
+    before = len(_held)
+    try:
+        yield
+    finally:
+        while len(_held) > before:
+            _held.pop().close()
+
+
 class RunDir:
-    def __init__(self, path: str, specs: Dict[str, dict]):
+    def __init__(self, path: str, specs: Dict[str, dict], lock: DirectoryLock):
         self.path = path
         self.specs = specs
+        self.lock = lock
         self._log = None
         self._warned_not_finite = False
+        _held.append(self)
 
     @property
     def finished(self) -> bool:
-        return os.path.exists(os.path.join(self.path, "summary.json"))
+        return is_finished(self.path)
+
+    def close(self) -> None:
+        if self._log is not None:
+            self._log.close()
+            self._log = None
+        self.lock.release()
+
+    def _check_still_held(self) -> None:
+        if self.lock.lost:
+            raise SystemExit(f"kage.ppo.train: {self.path}: another process took this run directory over (this one "
+                             "was taken for dead: no heartbeat); stopping without writing more")
 
     @classmethod
     def open(cls, args, configs: List[Tuple[str, str]]) -> "RunDir":
         """The run directory of `args`, which trains and evaluates on `configs` ((label, path): "train"
         first): created with its description, or checked against it."""
         path = args.out or default_dir(args)
-        specs = {}
-        for label, config in configs:
-            if not os.path.exists(config):
-                raise SystemExit(f"kage.ppo.train: config '{config}' ({label}) not found")
-            specs[label] = front_end.resolve(config, args.asset_root)
-        described = {label: {"path": config, "spec_sha256": specs[label]["sha256"]} for label, config in configs}
-        for folder in ("", "configs", "certificates", "checkpoints", "videos"):
-            remove_strays(os.path.join(path, folder))  # a killed writer's, or one that met a full disk
-        run_json = os.path.join(path, "run.json")
-        if os.path.exists(run_json):
-            with open(run_json) as f:
-                previous = json.load(f)
-            check_same_run(path, previous, json_args(args), described)
-        else:
-            os.makedirs(os.path.join(path, "configs"), exist_ok=True)
-            os.makedirs(os.path.join(path, "certificates"), exist_ok=True)
-            os.makedirs(os.path.join(path, "checkpoints"), exist_ok=True)
-            for label, config in configs:
-                write_json(os.path.join(path, "configs", f"{safe(label)}.json"), specs[label])
-                if label != "train":
-                    certificate = front_end.certify(args.train_config_path, config, args.asset_root)
-                    write_json(os.path.join(path, "certificates", f"{safe(label)}.json"), certificate)
-            write_json(run_json, {
-                "kage_run": 1, "args": json_args(args), "argv": sys.argv, "configs": described,
-                "code_version": code_version(), "python": sys.version.split()[0], "torch": torch.__version__,
-                "device_name": torch.cuda.get_device_name() if args.device == "cuda" and torch.cuda.is_available()
-                else "cpu", "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-                "derived": {"batch_size": args.batch_size, "minibatch_size": args.minibatch_size,
-                            "num_iterations": args.num_iterations}})
-        return cls(path, specs)
+        specs, described = resolve_configs(configs, args.asset_root)
+        os.makedirs(path, exist_ok=True)
+        lock = DirectoryLock(path, "run", "kage.ppo.train")
+        try:
+            lock.acquire("Wait for it to end or stop it, or use another --out")
+        except LockHeld as e:
+            raise SystemExit(f"kage.ppo.train: {e}") from None
+        try:
+            describe_or_check(path, args, configs, specs, described)
+        except BaseException:
+            lock.release()
+            raise
+        return cls(path, specs, lock)
 
     def check_env(self, label: str, env) -> None:
         """Refuses a batch that runs another Spec than the one this directory records for `label` (its config
@@ -123,6 +140,7 @@ class RunDir:
         """Appends one row to metrics.jsonl, flushed and synced; returns it. A value that is not finite (a
         diverged run's losses) is written as null, with a warning the first time: the run's log stays
         valid JSON, and the other runs of its pack go on."""
+        self._check_still_held()
         if self._log is None:
             self._log = open(os.path.join(self.path, "metrics.jsonl"), "a")
         bad = sorted(k for k, v in row.items() if isinstance(v, float) and not math.isfinite(v))
@@ -160,6 +178,7 @@ class RunDir:
     def save_checkpoint(self, state: dict) -> None:
         """checkpoints/latest.pt, and latest.json naming its iteration (read by kage.bench to pack runs
         that resume from the same iteration without loading the checkpoints)."""
+        self._check_still_held()
         atomic_write(os.path.join(self.path, "checkpoints", "latest.pt"), checkpoint.encode(state))
         write_json(os.path.join(self.path, "checkpoints", "latest.json"), {"iteration": state["iteration"]})
 
@@ -181,9 +200,54 @@ class RunDir:
     def finish(self, history: List[dict]) -> None:
         """summary.json: per evaluated value, its min, mean, median and max over all evaluation points,
         iteration 0 and the final one included (§3.4); each statistic over the points that have a value."""
+        self._check_still_held()
         write_json(os.path.join(self.path, "summary.json"), summarize(history))
-        if self._log is not None:
-            self._log.close()
+
+
+def resolve_configs(configs: List[Tuple[str, str]], asset_root: Optional[str]) -> Tuple[Dict[str, dict], Dict[str, dict]]:
+    """Each config's resolved Spec, and the run's description of them ({label: {"path", "spec_sha256"}})."""
+    specs = {}
+    for label, config in configs:
+        if not os.path.exists(config):
+            raise SystemExit(f"kage.ppo.train: config '{config}' ({label}) not found")
+        specs[label] = front_end.resolve(config, asset_root)
+    return specs, {label: {"path": config, "spec_sha256": specs[label]["sha256"]} for label, config in configs}
+
+
+def check_finished(path: str, args, configs: List[Tuple[str, str]]) -> None:
+    """Refuses a finished run's directory to other arguments or changed configs, as a resume would (reads only)."""
+    with open(os.path.join(path, "run.json")) as f:
+        previous = json.load(f)
+    check_same_run(path, previous, json_args(args), resolve_configs(configs, args.asset_root)[1])
+
+
+def describe_or_check(path: str, args, configs: List[Tuple[str, str]], specs: Dict[str, dict],
+                      described: Dict[str, dict]) -> None:
+    """Under the run's lock: a new run's description written (run.json last), or an existing one checked against
+    `args` and `described`; dead writers' temporary files removed."""
+    for folder in ("", "configs", "certificates", "checkpoints", "videos"):
+        remove_strays(os.path.join(path, folder))  # a killed writer's, or one that met a full disk
+    run_json = os.path.join(path, "run.json")
+    if os.path.exists(run_json):
+        with open(run_json) as f:
+            previous = json.load(f)
+        check_same_run(path, previous, json_args(args), described)
+        return
+    os.makedirs(os.path.join(path, "configs"), exist_ok=True)
+    os.makedirs(os.path.join(path, "certificates"), exist_ok=True)
+    os.makedirs(os.path.join(path, "checkpoints"), exist_ok=True)
+    for label, config in configs:
+        write_json(os.path.join(path, "configs", f"{safe(label)}.json"), specs[label])
+        if label != "train":
+            certificate = front_end.certify(args.train_config_path, config, args.asset_root)
+            write_json(os.path.join(path, "certificates", f"{safe(label)}.json"), certificate)
+    write_json(run_json, {
+        "kage_run": 1, "args": json_args(args), "argv": sys.argv, "configs": described,
+        "code_version": code_version(), "python": sys.version.split()[0], "torch": torch.__version__,
+        "device_name": torch.cuda.get_device_name() if args.device == "cuda" and torch.cuda.is_available()
+        else "cpu", "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "derived": {"batch_size": args.batch_size, "minibatch_size": args.minibatch_size,
+                    "num_iterations": args.num_iterations}})
 
 
 def optimizer_run_state(optimizer: torch.optim.Adam, agent, run: int) -> dict:

@@ -48,7 +48,7 @@ from kage.ppo.losses import clip_grad_norm_per_run, compute_gae, entropy_coeffic
 from kage.ppo.policy import RolloutPolicy, autocast
 from kage.ppo.wrappers import FrameStack, RewardNormalizer
 from kage.util.files import safe
-from kage.util.stop import StopRequest
+from kage.util.stop import StopRequest, die_with_parent
 
 ACTION_STREAM, SHUFFLE_STREAM = 1, 2  # the two random streams of a run (§2.4); evaluations use their own keys
 AUGMENT_STREAM = 3  # --augment's draws (not in the original)
@@ -60,7 +60,14 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
           stop: Optional[StopRequest] = None) -> List["Run"]:
     """Trains the runs of `pack` together (one for a lone run) to the end, or `stop_after` iterations past
     where they start (kage.bench speed). Resumes each run from its checkpoint if it has one. Once `stop` is
-    requested (a signal), checkpoints after the running iteration and exits."""
+    requested (a signal), checkpoints after the running iteration and exits. Each run directory is locked from
+    its opening to the end (kage.util.lock)."""
+    with rundir.held_open():
+        return train_locked(pack, timer, stop_after, stop)
+
+
+def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optional[StopRequest]) -> List["Run"]:
+    """train(), with its run directories closed by the caller."""
     args = check_pack(pack)
     stop = stop or StopRequest("kage.ppo.train", "")
     timer = timer or NoTimer()
@@ -472,13 +479,15 @@ def train_rows(measured: List[Dict[str, object]], iteration: int, global_step: i
 
 
 def main(argv: Optional[List[str]] = None) -> int:
+    die_with_parent()  # under kage.bench run: its death (even SIGKILL) stops this trainer too
     parsed = parse_args(argv)
     pack = parsed if isinstance(parsed, list) else [parsed]
     unfinished = []
     for args in pack:
-        run_dir = rundir.RunDir.open(args, configs_of(args))
-        if run_dir.finished:
-            print(f"kage.ppo.train: {run_dir.path} is finished (summary.json); nothing to do", file=sys.stderr)
+        path = args.out or rundir.default_dir(args)
+        if rundir.is_finished(path):
+            rundir.check_finished(path, args, configs_of(args))
+            print(f"kage.ppo.train: {path} is finished (summary.json); nothing to do", file=sys.stderr)
         else:
             unfinished.append(args)
     if unfinished:

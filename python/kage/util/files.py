@@ -20,7 +20,7 @@ _TEMPORARY = re.compile(r"^.+\.tmp\.(?P<host>[^/]+?)\.(?P<pid>\d+)(?:\.[0-9a-f]+
 
 def atomic_write(path: str, data: bytes) -> None:
     """Writes `data` to a new temporary file beside `path`, syncs it, then renames it over `path`."""
-    name, fd = _create_temporary(path)
+    name, fd = create_temporary(path)
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)
@@ -32,7 +32,7 @@ def atomic_write(path: str, data: bytes) -> None:
         raise
 
 
-def _create_temporary(path: str):
+def create_temporary(path: str):
     """(name, file descriptor) of a new file beside `path` that nobody else could have created or planted."""
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
     for _ in range(100):

@@ -2,13 +2,18 @@
 running iteration finish, then the trainer checkpoints and exits, so a rerun resumes with nothing lost.
 A second Ctrl-C stops at once (the run then resumes from its previous checkpoint); a repeated SIGTERM
 changes nothing, since schedulers and kage.bench may both send one. The runners stop their child processes
-through stop_children."""
+through stop_children, and a child started with child_environment() stops with its runner however the runner
+ends (die_with_parent)."""
+import ctypes
+import os
 import signal
 import subprocess
 import sys
-from typing import List, Optional
+from typing import Dict, List, Optional
 
 SIGNALS = (signal.SIGTERM, signal.SIGINT)
+PARENT_ENV = "KAGE_PARENT_PID"  # set by a runner for its children: the process whose death stops them
+_PR_SET_PDEATHSIG = 1
 
 
 class StopRequest:
@@ -45,6 +50,28 @@ class StopRequest:
     def exit_code(self) -> int:
         return 128 + (self.signum or 0)  # the shell's convention for "ended by signal N"
 
+
+
+def child_environment(**extra: str) -> Dict[str, str]:
+    """The environment of a runner's child process: die_with_parent() in the child then ties it to this process."""
+    return {**os.environ, PARENT_ENV: str(os.getpid()), **extra}
+
+
+def die_with_parent() -> None:
+    """In a runner's child (PARENT_ENV set): asks the kernel for a SIGTERM when the runner ends, even by SIGKILL
+    or with its whole process group, so that no trainer goes on writing a run nobody watches (Linux; a no-op
+    elsewhere). SIGTERM lets a trainer checkpoint first. A runner already gone by now stops this process at once."""
+    parent = os.environ.get(PARENT_ENV)
+    if not parent or not parent.isdigit():
+        return
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0) != 0:
+            return
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != int(parent):
+        os.kill(os.getpid(), signal.SIGTERM)
 
 
 def stop_children(children: List[subprocess.Popen], grace_s: float = 180) -> None:
