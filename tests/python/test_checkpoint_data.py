@@ -128,3 +128,16 @@ def test_a_checkpoint_of_the_earlier_pickled_format_is_read_as_data_or_refused_b
         assert done.returncode == 0, done.stderr
     else:
         assert done.returncode != 0 and "torch 2.x" in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
+def test_numpy_numbers_are_kept_as_their_values_and_other_objects_refused(tmp_path):
+    import numpy as np
+
+    path = tmp_path / "state.pt"
+    state = {"agent": {}, "iteration": np.int64(7), "mean": np.float32(0.5), "flag": np.bool_(True)}
+    path.write_bytes(checkpoint.encode(state))
+    loaded = checkpoint.load(str(path))
+    assert (loaded["iteration"], loaded["mean"], loaded["flag"]) == (7, 0.5, True)
+    assert type(loaded["iteration"]) is int and type(loaded["flag"]) is bool
+    with pytest.raises(TypeError, match="data only, not ndarray"):
+        checkpoint.encode({"array": np.zeros(2)})

@@ -16,6 +16,7 @@ import io
 import json
 from typing import Any, List
 
+import numpy as np
 import torch
 
 FORMAT = "kage.ppo.checkpoint/2"
@@ -45,6 +46,8 @@ def encode(state: dict) -> bytes:
             return [pack(v) for v in value]
         if value is None or isinstance(value, (bool, int, float, str)):
             return value
+        if isinstance(value, np.generic) and value.dtype.kind in "biuf":  # a numpy number: its Python value
+            return value.item()
         raise TypeError(f"a checkpoint holds data only, not {type(value).__name__}")
 
     text = json.dumps(pack(state), sort_keys=True).encode()  # Infinity and NaN as Python's json writes them
