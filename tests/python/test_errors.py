@@ -87,9 +87,19 @@ def test_gpu_actions_for_a_cpu_env(env, actions):
 
 
 def test_valid_inputs_of_every_host_kind(env):
-    for actions in (np.array([1, 2, 3, 4], dtype=np.uint8), [7, 6, 5, 4], torch.tensor([0, 2, 4, 6], dtype=torch.int32),
-                    np.array([2, 2, 2, 2], dtype=np.int64)[::1]):
-        env.step(actions)
+    """Each host kind of actions steps the batch exactly as the same values as an int32 numpy array do, on a twin
+    batch of the same config and seed."""
+    with kage.make_vec(SIMPLEST, 4) as twin:
+        twin.reset(seed=0)
+        for actions, values in ((np.array([1, 2, 3, 4], dtype=np.uint8), [1, 2, 3, 4]), ([7, 6, 5, 4], [7, 6, 5, 4]),
+                                (torch.tensor([0, 2, 4, 6], dtype=torch.int32), [0, 2, 4, 6]),
+                                (np.array([2, 2, 2, 2, 9, 9, 9, 9], dtype=np.int64)[:4], [2, 2, 2, 2])):
+            obs, reward, _, _, info = env.step(actions)
+            want_obs, want_reward, _, _, want_info = twin.step(np.array(values, dtype=np.int32))
+            assert np.array_equal(obs, want_obs) and np.array_equal(reward, want_reward), type(actions)
+            assert np.array_equal(info["x"], want_info["x"]) and np.array_equal(info["vx"], want_info["vx"])
+        # Right (2) and left (1) moved the environments apart: the comparison saw actions that mattered.
+        assert len(set(info["x"].tolist())) > 1
 
 
 def test_bad_reset_arguments(env):
