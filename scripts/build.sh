@@ -36,7 +36,7 @@ fi
 export CMAKE_BUILD_PARALLEL_LEVEL=$(nproc)
 # No build isolation: the venv's pinned scikit-build-core and pybind11 build it, and the build folder's
 # paths stay the same from one run to the next.
-"$python" -m pip install -q --no-build-isolation -C build-dir="$build" -C cmake.build-type=RelWithDebInfo \
-  -C cmake.define.KAGE_BUILD_TESTS=ON -C cmake.define.KAGE_CUDA="${KAGE_CUDA:-AUTO}" .
+"$python" -m pip install -q --no-build-isolation -C build-dir="$build" -C cmake.define.KAGE_BUILD_TESTS=ON \
+  -C cmake.define.KAGE_CUDA="${KAGE_CUDA:-AUTO}" .
 "$python" -c 'import kage; print(f"build.sh: kage {kage.__version__} installed into .venv, GPU backend built: "
                                  f"{kage.gpu_backend_built()}; build folder '"$build"'")'

@@ -43,6 +43,9 @@ std::vector<std::string> nvrtc_candidates() {
     if (const char* v = std::getenv(var); v && *v) add_dir(&out, std::string(v) + "/lib64");
   }
   for (const char* name : kNames) out.emplace_back(name);
+#ifdef KAGE_NVRTC_BUILD_LIB_DIR
+  add_dir(&out, KAGE_NVRTC_BUILD_LIB_DIR);  // beside the header the build used (runtime/cuda/CMakeLists.txt)
+#endif
   add_dir(&out, "/usr/local/cuda/lib64");  // the toolkit's default place, often not on the loader's path
   return out;
 }

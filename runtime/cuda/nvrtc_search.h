@@ -14,7 +14,8 @@ void set_nvrtc_dirs(std::vector<std::string> dirs);
 
 /// What dlopen tries, first loaded wins: libnvrtc.so.13, libnvrtc.so.12 and libnvrtc.so in each
 /// directory set above, then in $CUDA_HOME/lib64 and $CUDA_PATH/lib64 (where set), then the bare names
-/// (the loader's path: LD_LIBRARY_PATH, ld.so.cache), then in /usr/local/cuda/lib64.
+/// (the loader's path: LD_LIBRARY_PATH, ld.so.cache), then in the folder of the NVRTC library the build
+/// found beside its nvrtc.h (a build with the CUDA backend), then in /usr/local/cuda/lib64.
 std::vector<std::string> nvrtc_candidates();
 
 /// dlopen (RTLD_NOW | RTLD_LOCAL) of the first candidate that loads, or nullptr.
