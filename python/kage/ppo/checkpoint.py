@@ -8,10 +8,13 @@ reads on every torch this package supports (1.13 reads neither Python floats nor
     "json"     the dict as JSON text (a uint8 tensor), each tensor replaced by {"__tensor__": i} and each bytes
                value by {"__bytes__": i}
     "tensors"  the list of those tensors (bytes values as uint8 tensors)
+    "sha256"   of the JSON text and every tensor's dtype, shape and bytes: a bit flipped on disk or an edit
+               is refused, since torch does not check the zip's CRCs
 
 Checkpoints written before this format (a pickled dict) are read with weights_only=True too, where the torch
 in use can (2.x); nothing is ever unpickled beyond what that loader allows.
 """
+import hashlib
 import io
 import json
 from typing import Any, List
@@ -52,9 +55,18 @@ def encode(state: dict) -> bytes:
 
     text = json.dumps(pack(state), sort_keys=True).encode()  # Infinity and NaN as Python's json writes them
     buffer = io.BytesIO()
-    torch.save({"format": FORMAT, "json": torch.frombuffer(bytearray(text), dtype=torch.uint8), "tensors": tensors},
-               buffer)
+    torch.save({"format": FORMAT, "json": torch.frombuffer(bytearray(text), dtype=torch.uint8), "tensors": tensors,
+                "sha256": digest(text, tensors)}, buffer)
     return buffer.getvalue()
+
+
+def digest(text: bytes, tensors: List[torch.Tensor]) -> str:
+    """SHA-256 of a checkpoint's JSON text and tensors (dtype, shape and bytes of each, in order)."""
+    h = hashlib.sha256(text)
+    for t in tensors:
+        h.update(f"|{t.dtype}{tuple(t.shape)}|".encode())
+        h.update(t.contiguous().reshape(-1).view(torch.uint8).numpy().tobytes())
+    return h.hexdigest()
 
 
 def load(path: str) -> dict:
@@ -81,8 +93,16 @@ def load(path: str) -> dict:
 def _decode(path: str, raw: dict) -> dict:
     tensors = raw.get("tensors")
     try:
-        tree = json.loads(bytes(raw["json"].numpy()).decode())
-    except (KeyError, ValueError, UnicodeDecodeError, TypeError, AttributeError) as e:
+        text = bytes(raw["json"].numpy())
+        intact = raw.get("sha256") == digest(text, tensors)
+    except (KeyError, TypeError, AttributeError, RuntimeError) as e:
+        raise CheckpointError(f"{path}: damaged: its parts are missing or of the wrong kind ({e})") from None
+    if not intact:
+        raise CheckpointError(f"{path}: damaged: its content does not match the SHA-256 it was written with (a bit "
+                              "flipped on disk, or an edit)")
+    try:
+        tree = json.loads(text.decode())
+    except (ValueError, UnicodeDecodeError) as e:
         raise CheckpointError(f"{path}: its JSON part is damaged ({e})") from None
 
     def unpack(value: Any) -> Any:

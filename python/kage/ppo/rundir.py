@@ -11,12 +11,18 @@
 
 Nothing is lost when the process is killed: files are replaced atomically (written beside, then
 renamed), log rows are flushed and synced one by one, and a rerun with the same arguments resumes from
-the checkpoint, dropping the log rows written after it, so the log has no gap and no duplicate. A
-finished run (summary.json) is never touched again; a config whose Spec changed since the run started is
-refused. One trainer writes a run directory at a time: a second one refuses at once, naming the first.
+the checkpoint, dropping the log rows written after it (and saying so), so the log has no gap and no
+duplicate. A finished run (summary.json) is never touched again; a config whose Spec changed since the run
+started is refused.
+
+A resume proves that the checkpoint, the log and the arguments belong together, or refuses naming what
+disagrees: the checkpoint's content hash (kage.ppo.checkpoint), the arguments and configs' spec hashes it
+records against the command line's, and the SHA-256 of the log's bytes up to its iteration against
+metrics.jsonl. A directory with a checkpoint or log rows but no run.json is refused. One trainer writes a run directory at a time: a second one refuses at once, naming the first.
 """
 import contextlib
 import dataclasses
+import hashlib
 import json
 import math
 import os
@@ -84,11 +90,13 @@ def held_open():
 
 
 class RunDir:
-    def __init__(self, path: str, specs: Dict[str, dict], lock: DirectoryLock):
+    def __init__(self, path: str, specs: Dict[str, dict], lock: DirectoryLock, identity: Optional[dict] = None):
         self.path = path
         self.specs = specs
         self.lock = lock
+        self.identity = identity  # {"args": json_args, "configs": {label: {"path", "spec_sha256"}}}, in checkpoints
         self._log = None
+        self._log_digest, self._log_bytes, self._log_rows = hashlib.sha256(), 0, 0  # metrics.jsonl so far
         self._warned_not_finite = False
         _held.append(self)
 
@@ -124,7 +132,7 @@ class RunDir:
         except BaseException:
             lock.release()
             raise
-        return cls(path, specs, lock)
+        return cls(path, specs, lock, {"args": json_args(args), "configs": described})
 
     def check_env(self, label: str, env) -> None:
         """Refuses a batch that runs another Spec than the one this directory records for `label` (its config
@@ -142,7 +150,7 @@ class RunDir:
         valid JSON, and the other runs of its pack go on."""
         self._check_still_held()
         if self._log is None:
-            self._log = open(os.path.join(self.path, "metrics.jsonl"), "a")
+            self._log = open(os.path.join(self.path, "metrics.jsonl"), "ab")
         bad = sorted(k for k, v in row.items() if isinstance(v, float) and not math.isfinite(v))
         if bad:
             row = {k: None if k in bad else v for k, v in row.items()}
@@ -151,27 +159,35 @@ class RunDir:
                       f"{row.get('iteration')}: the run has diverged; such values are logged as null",
                       file=sys.stderr, flush=True)
                 self._warned_not_finite = True
-        self._log.write(json.dumps(row, sort_keys=True, allow_nan=False) + "\n")
+        line = (json.dumps(row, sort_keys=True, allow_nan=False) + "\n").encode()
+        self._log.write(line)
         self._log.flush()
         os.fsync(self._log.fileno())
+        self._log_digest.update(line)
+        self._log_bytes, self._log_rows = self._log_bytes + len(line), self._log_rows + 1
         return row
 
-    def _truncate_log(self, iteration: int) -> None:
-        """Keeps the rows of iterations up to `iteration` (written before its checkpoint) and drops the
-        rest, a partly written last line included."""
+    def _restart_log(self, recorded: Optional[dict], iteration: int) -> None:
+        """Checks that metrics.jsonl begins with the bytes a checkpoint recorded (`recorded`: bytes, rows,
+        sha256; None for no checkpoint), then drops what follows them, saying so: those rows are written again."""
         path = os.path.join(self.path, "metrics.jsonl")
-        if not os.path.exists(path):
-            return
-        kept = []
-        with open(path) as f:
-            for line in f:
-                try:
-                    row = json.loads(line)
-                except json.JSONDecodeError:
-                    break
-                if row["iteration"] <= iteration:
-                    kept.append(line if line.endswith("\n") else line + "\n")
-        atomic_write(path, "".join(kept).encode())
+        try:
+            with open(path, "rb") as f:
+                data = f.read()
+        except FileNotFoundError:
+            data = b""
+        keep = recorded["bytes"] if recorded else 0
+        if recorded and (len(data) < keep or hashlib.sha256(data[:keep]).hexdigest() != recorded["sha256"]):
+            raise SystemExit(f"kage.ppo.train: {log_problem(path, data, keep, iteration)}; restore the log, or train "
+                             "anew with another --out")
+        dropped = data[keep:]
+        if dropped:
+            print(f"kage.ppo.train: {path}: {dropped_text(dropped)} written after "
+                  f"{f'the checkpoint of iteration {iteration}' if recorded else 'the run started (no checkpoint yet)'} "
+                  "dropped; this run writes them again", file=sys.stderr, flush=True)
+            atomic_write(path, data[:keep])
+        self._log_digest = hashlib.sha256(data[:keep])
+        self._log_bytes, self._log_rows = keep, recorded["rows"] if recorded else 0
 
     # ---- checkpoints ----
 
@@ -179,21 +195,44 @@ class RunDir:
         """checkpoints/latest.pt, and latest.json naming its iteration (read by kage.bench to pack runs
         that resume from the same iteration without loading the checkpoints)."""
         self._check_still_held()
+        state = dict(state, identity=self.identity,
+                     log={"bytes": self._log_bytes, "rows": self._log_rows, "sha256": self._log_digest.hexdigest()})
         atomic_write(os.path.join(self.path, "checkpoints", "latest.pt"), checkpoint.encode(state))
         write_json(os.path.join(self.path, "checkpoints", "latest.json"), {"iteration": state["iteration"]})
 
-    def load_checkpoint(self, device) -> Optional[dict]:
-        """The latest checkpoint (and the log cut back to it), or None for a fresh run (the log emptied)."""
+    def load_checkpoint(self) -> Optional[dict]:
+        """The latest checkpoint, proven to be this run's (and the log cut back to it), or None for a fresh run
+        (the log emptied)."""
         path = os.path.join(self.path, "checkpoints", "latest.pt")
         if not os.path.exists(path):
-            self._truncate_log(-1)
+            self._restart_log(None, 0)
             return None
         try:
             state = checkpoint.load(path)
         except checkpoint.CheckpointError as e:
-            raise SystemExit(f"kage.ppo.train: {e}\nkage.ppo.train: to train anew, use another --out") from None
-        self._truncate_log(state["iteration"])
+            raise SystemExit(f"kage.ppo.train: {e}\nkage.ppo.train: restore it, or train anew with another --out") \
+                from None
+        self._check_identity(path, state)
+        self._restart_log(state["log"], state["iteration"])
         return state
+
+    def _check_identity(self, path: str, state: dict) -> None:
+        """Refuses a checkpoint that records other arguments or configs than this run's (another seed's copied in,
+        or one written before checkpoints recorded them)."""
+        recorded = state.get("identity")
+        if not isinstance(recorded, dict) or not isinstance(state.get("log"), dict):
+            raise SystemExit(f"kage.ppo.train: {path} does not record the arguments, configs and log it belongs to "
+                             "(an earlier kage.ppo.train wrote it), so it cannot be proven to be this run's: finish "
+                             "the run with that version, or train anew with another --out")
+        problems = [f"{k}: {v!r} in the checkpoint, {self.identity['args'][k]!r} now"
+                    for k, v in changed_arguments(recorded["args"], self.identity["args"])]
+        for label, now in self.identity["configs"].items():
+            before = recorded["configs"].get(label)
+            if before != now:
+                problems.append(f"config {label}: {before} in the checkpoint, {now} now")
+        if problems:
+            raise SystemExit(f"kage.ppo.train: {path} belongs to another run ({'; '.join(problems)}): restore this "
+                             "run's checkpoint, or train anew with another --out")
 
     # ---- the summary ----
 
@@ -233,6 +272,10 @@ def describe_or_check(path: str, args, configs: List[Tuple[str, str]], specs: Di
             previous = json.load(f)
         check_same_run(path, previous, json_args(args), described)
         return
+    log = os.path.join(path, "metrics.jsonl")
+    if os.path.exists(os.path.join(path, "checkpoints", "latest.pt")) or (os.path.exists(log) and os.path.getsize(log)):
+        raise SystemExit(f"kage.ppo.train: {path} has a checkpoint or log rows but no run.json, so nothing shows which "
+                         "arguments and configs they belong to: restore run.json, or train anew with another --out")
     os.makedirs(os.path.join(path, "configs"), exist_ok=True)
     os.makedirs(os.path.join(path, "certificates"), exist_ok=True)
     os.makedirs(os.path.join(path, "checkpoints"), exist_ok=True)
@@ -302,6 +345,43 @@ def statistics_of(values: List[Optional[float]]) -> Optional[dict]:
             "max": max(present), "n": len(present)}
 
 
+def log_problem(path: str, data: bytes, keep: int, iteration: int) -> str:
+    """Why the log's first `keep` bytes are not those the checkpoint of `iteration` recorded."""
+    for number, line in enumerate(data[:keep].splitlines(), 1):
+        try:
+            json.loads(line)
+        except ValueError:
+            return f"{path} line {number} is damaged (not a JSON row), before the checkpoint of iteration {iteration}"
+    if len(data) < keep:
+        return (f"{path} has {len(data)} bytes, but {keep} were written up to the checkpoint of iteration {iteration}: "
+                "rows are missing")
+    return f"{path}: its rows up to the checkpoint of iteration {iteration} differ from those written then (edited?)"
+
+
+def dropped_text(dropped: bytes) -> str:
+    """'2 log rows (iterations 3-4)', with a partly written last line where there is one."""
+    iterations, torn = [], False
+    for line in dropped.splitlines():
+        try:
+            iterations.append(json.loads(line)["iteration"])
+        except (ValueError, KeyError, TypeError):
+            torn = True
+    text = f"{len(iterations)} log row{'s' if len(iterations) != 1 else ''}"
+    if iterations:
+        span = f"{min(iterations)}-{max(iterations)}" if min(iterations) != max(iterations) else str(iterations[0])
+        text += f" (iteration{'s' if min(iterations) != max(iterations) else ''} {span})"
+    return text + (" and a partly written line" if torn else "")
+
+
+def changed_arguments(before: dict, now: dict) -> List[Tuple[str, object]]:
+    """(name, value before) of each argument in `now` that differs from `before` (arguments added since count
+    with their earlier meaning; moved module paths name the same code), those a resume may change left out."""
+    before = dict(_ADDED_ARGUMENTS, **before)
+    for key in ("agent", "augment"):
+        before[key] = plugins.current_reference(before.get(key))
+    return [(k, before.get(k)) for k in sorted(now) if k not in _RESUMABLE_CHANGES and before.get(k) != now[k]]
+
+
 def check_same_run(path: str, previous: dict, args: dict, configs: dict) -> None:
     """Refuses to resume `path` with other arguments or with configs whose Spec changed."""
     for label, now in configs.items():
@@ -313,12 +393,9 @@ def check_same_run(path: str, previous: dict, args: dict, configs: dict) -> None
                 f"kage.ppo.train: config '{now['path']}' ({label}) changed since {path} started (spec "
                 f"{before['spec_sha256'][:12]} then, {now['spec_sha256'][:12]} now): restore it, or start a new run "
                 "with another --out")
-    before = dict(_ADDED_ARGUMENTS, **previous["args"])
-    for key in ("agent", "augment"):  # module paths that moved name the same code
-        before[key] = plugins.current_reference(before.get(key))
-    changed = sorted(k for k in args if k not in _RESUMABLE_CHANGES and before.get(k) != args[k])
+    changed = changed_arguments(previous["args"], args)
     if changed:
-        details = ", ".join(f"{k}: {before.get(k)!r} then, {args[k]!r} now" for k in changed)
+        details = ", ".join(f"{k}: {before!r} then, {args[k]!r} now" for k, before in changed)
         raise SystemExit(f"kage.ppo.train: {path} was started with other arguments ({details}); "
                          "rerun with the original ones to resume, or use another --out")
 

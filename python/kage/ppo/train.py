@@ -376,7 +376,7 @@ def save_checkpoints(runs: List[Run], agent, optimizer, state: LoopState, stack,
 def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalizer, boards, device) -> bool:
     """Loads the runs' checkpoints, if they have any, into the network, optimizer, environments and loop state;
     whether they had."""
-    checkpoints = [run.dir.load_checkpoint(device) for run in runs]
+    checkpoints = [run.dir.load_checkpoint() for run in runs]
     if all(c is None for c in checkpoints):
         return False
     if any(c is None or c["iteration"] != checkpoints[0]["iteration"] for c in checkpoints):
@@ -401,7 +401,8 @@ def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalize
     state.iteration, state.global_step = c["iteration"], c["global_step"]
     state.optimizer_steps, state.train_seconds = c["optimizer_steps"], c["train_seconds"]
     for run in runs:
-        print(f"kage.ppo.train: resuming {run.dir.path} after iteration {c['iteration']}", file=sys.stderr)
+        print(f"kage.ppo.train: resuming {run.dir.path} after iteration {c['iteration']} (its checkpoint, log and "
+              "arguments agree)", file=sys.stderr)
     return True
 
 
