@@ -115,7 +115,12 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
     pack = namespace.pop("pack")
     if pack:
         with open(pack) as f:
-            return [Args(**run) for run in json.load(f)["runs"]]
+            runs = [Args(**run) for run in json.load(f)["runs"]]
+        for args in runs:
+            problems = validate(args)
+            if problems:
+                parser.error(f"{pack}: run {args.out}: " + "; ".join(problems))
+        return runs
     args = Args(**namespace)
     problems = validate(args)
     if problems:
@@ -123,9 +128,46 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
     return args
 
 
+MAX_INT32 = 2**31 - 1  # the environment API's counts are int32
+
+
+def range_problems(args: Args) -> List[str]:
+    """Values outside what the baseline's arguments mean (§2.1): a discount above 1, a negative or infinite
+    learning rate, a clip norm that would not clip (or ascend), counts that are not positive."""
+    problems = []
+
+    def need(ok: bool, text: str) -> None:
+        if not ok:
+            problems.append(text)
+
+    finite = math.isfinite
+    need(finite(args.learning_rate) and args.learning_rate > 0, f"--learning-rate {args.learning_rate}: a positive "
+         "finite step size")
+    need(0 <= args.gamma <= 1, f"--gamma {args.gamma}: a discount in [0, 1]")
+    need(0 <= args.gae_lambda <= 1, f"--gae-lambda {args.gae_lambda}: in [0, 1]")
+    need(finite(args.clip_coef) and args.clip_coef > 0, f"--clip-coef {args.clip_coef}: positive and finite")
+    need(finite(args.ent_coef) and args.ent_coef >= 0, f"--ent-coef {args.ent_coef}: finite and not negative")
+    need(finite(args.vf_coef) and args.vf_coef >= 0, f"--vf-coef {args.vf_coef}: finite and not negative")
+    need(args.max_grad_norm > 0, f"--max-grad-norm {args.max_grad_norm}: a positive norm (a negative one would "
+         "ascend the gradient; inf turns clipping off)")
+    need(not math.isnan(args.reward_clip_min) and not math.isnan(args.reward_clip_max)
+         and args.reward_clip_min <= args.reward_clip_max,
+         f"--reward-clip-min {args.reward_clip_min} and --reward-clip-max {args.reward_clip_max}: min <= max")
+    need(args.update_epochs > 0, f"--update-epochs {args.update_epochs}: a positive number")
+    need(args.num_minibatches > 0, f"--num-minibatches {args.num_minibatches}: a positive number")
+    need(args.total_timesteps > 0, f"--total-timesteps {args.total_timesteps}: a positive number")
+    need(0 <= args.seed < 2**63, f"--seed {args.seed}: in [0, 2**63)")
+    need(args.save_checkpoint_every >= 0, f"--save-checkpoint-every {args.save_checkpoint_every}: 0 (at the end "
+         "only) or a positive number of iterations")
+    need(args.threads is None or 0 < args.threads <= 4096, f"--threads {args.threads}: a positive number of threads")
+    need(args.num_envs <= MAX_INT32 and args.eval_num_envs <= MAX_INT32 and args.num_steps <= MAX_INT32,
+         f"--num-envs, --eval-num-envs and --num-steps: at most {MAX_INT32}")
+    return problems
+
+
 def validate(args: Args) -> List[str]:
     """What is wrong with a combination of flags, each with its fix."""
-    problems = []
+    problems = range_problems(args)
     if not args.train_config_path:
         problems.append("--train-config-path is required")
     if args.eval_config_path and args.eval_config_paths:
@@ -134,10 +176,10 @@ def validate(args: Args) -> List[str]:
         problems.append(f"--device {args.device}: use cuda or cpu")
     if args.num_envs <= 0 or args.num_steps <= 0:
         problems.append("--num-envs and --num-steps must be positive")
-    elif args.batch_size % args.num_minibatches:
+    elif args.num_minibatches > 0 and args.batch_size % args.num_minibatches:
         problems.append(f"--num-minibatches {args.num_minibatches} must divide the batch (num_envs * num_steps "
                         f"= {args.batch_size})")
-    elif args.num_iterations < 1:
+    elif args.num_minibatches > 0 and args.num_iterations < 1:
         problems.append(f"--total-timesteps {args.total_timesteps} is less than one batch ({args.batch_size})")
     if args.run_eval_every < 0 or args.eval_episodes < 0 or args.eval_num_envs < 0:
         problems.append("--run-eval-every, --eval-episodes and --eval-num-envs must not be negative")

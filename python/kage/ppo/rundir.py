@@ -116,11 +116,11 @@ class RunDir:
                              "was taken for dead: no heartbeat); stopping without writing more")
 
     @classmethod
-    def open(cls, args, configs: List[Tuple[str, str]]) -> "RunDir":
+    def open(cls, args, configs: List[Tuple[str, str]], specs: Dict[str, dict]) -> "RunDir":
         """The run directory of `args`, which trains and evaluates on `configs` ((label, path): "train"
-        first): created with its description, or checked against it."""
+        first) whose resolved Specs are `specs`: locked, then created with its description, or checked against it."""
         path = args.out or default_dir(args)
-        specs, described = resolve_configs(configs, args.asset_root)
+        described = {label: {"path": config, "spec_sha256": specs[label]["sha256"]} for label, config in configs}
         os.makedirs(path, exist_ok=True)
         lock = DirectoryLock(path, "run", "kage.ppo.train")
         try:
@@ -134,13 +134,6 @@ class RunDir:
             raise
         return cls(path, specs, lock, {"args": json_args(args), "configs": described})
 
-    def check_env(self, label: str, env) -> None:
-        """Refuses a batch that runs another Spec than the one this directory records for `label` (its config
-        file changed between the two reads)."""
-        recorded = self.specs[label]["sha256"]
-        if env.spec_hash != recorded:
-            raise SystemExit(f"kage.ppo.train: config '{env.config}' ({label}) changed while {self.path} was opened "
-                             f"(spec {recorded[:12]} recorded, {env.spec_hash[:12]} in the environment): run again")
 
     # ---- the log ----
 
@@ -241,6 +234,15 @@ class RunDir:
         iteration 0 and the final one included (§3.4); each statistic over the points that have a value."""
         self._check_still_held()
         write_json(os.path.join(self.path, "summary.json"), summarize(history))
+
+
+def check_env(specs: Dict[str, dict], label: str, env) -> None:
+    """Refuses a batch that runs another Spec than the one resolved for `label` (its config file changed between
+    the two reads)."""
+    recorded = specs[label]["sha256"]
+    if env.spec_hash != recorded:
+        raise SystemExit(f"kage.ppo.train: config '{env.config}' ({label}) changed while the run was being opened "
+                         f"(spec {recorded[:12]} resolved, {env.spec_hash[:12]} in the environment): run again")
 
 
 def resolve_configs(configs: List[Tuple[str, str]], asset_root: Optional[str]) -> Tuple[Dict[str, dict], Dict[str, dict]]:

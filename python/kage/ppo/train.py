@@ -72,7 +72,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     stop = stop or StopRequest("kage.ppo.train", "")
     timer = timer or NoTimer()
     device, threads = choose_device(args)
-    runs = [open_run(a, threads) for a in pack]
+    # Everything that can be refused is checked before a run directory is written: the configs, the batches
+    # (their size against the memory), the agent and the augmentation.
+    runs = [open_batches(a, threads) for a in pack]
     K, T, N = len(runs), args.num_steps, args.num_envs
     height, width, channels = runs[0].env.single_observation_space.shape
     channels *= 4 if args.use_frame_stack else 1
@@ -80,6 +82,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     agent = plugins.build_agent(args.agent, (height, width, channels), num_actions, [a.seed for a in pack], device,
                                 speed_modes(args))  # §2.4: the runs' seeds
     augment = plugins.load_augment(args.augment)
+    for run in runs:
+        open_run_dir(run)
     agent_spec = {"agent": args.agent, "observation_shape": [height, width, channels], "num_actions": num_actions,
                   "use_frame_stack": args.use_frame_stack}  # what kage.ppo.evaluate needs to rebuild a run's policy
     optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5)
@@ -253,26 +257,39 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
 class Run:
     """What a run owns besides its slice of the network: its arguments, directory and environments."""
     args: Args
-    dir: rundir.RunDir
+    specs: Dict[str, dict]  # each config's resolved Spec, by label
     env: "kage.VecEnv"
     eval_envs: Dict[str, "kage.VecEnv"]  # "train", then the eval configs by label
+    dir: Optional[rundir.RunDir] = None  # opened once everything that can be refused was checked
     history: List[dict] = field(default_factory=list)
 
 
-def open_run(args: Args, threads: int) -> Run:
-    """The run's directory (created or checked before anything else is written), then its batches, each
-    checked to run the Spec the directory records."""
-    run_dir = rundir.RunDir.open(args, configs_of(args))
-    env = kage.make_vec(args.train_config_path, args.num_envs, device=args.device, seed=args.seed,
-                        asset_root=args.asset_root, threads=threads)
-    run_dir.check_env("train", env)
+def open_batches(args: Args, threads: int) -> Run:
+    """The run's configs resolved and its batches made, each checked to run the resolved Spec; nothing written."""
+    specs = rundir.resolve_configs(configs_of(args), args.asset_root)[0]
+    env = make_batch(specs, "train", args.train_config_path, args.num_envs, args, threads, seed=args.seed)
     eval_envs = {}
     if args.run_eval_every > 0 and args.eval_episodes > 0 and args.eval_num_envs > 0:
         for label, path in configs_of(args):
-            eval_envs[label] = kage.make_vec(path, args.eval_num_envs, device=args.device, asset_root=args.asset_root,
-                                             threads=threads)
-            run_dir.check_env(label, eval_envs[label])
-    return Run(args, run_dir, env, eval_envs)
+            eval_envs[label] = make_batch(specs, label, path, args.eval_num_envs, args, threads)
+    return Run(args, specs, env, eval_envs)
+
+
+def make_batch(specs: Dict[str, dict], label: str, path: str, num_envs: int, args: Args, threads: int,
+               **seed) -> "kage.VecEnv":
+    """A batch of config `label`, checked to run the Spec resolved for it; what make_vec refuses (too large for
+    the memory, no GPU) ends the trainer with its message."""
+    try:
+        env = kage.make_vec(path, num_envs, device=args.device, asset_root=args.asset_root, threads=threads, **seed)
+    except (ValueError, RuntimeError, OSError) as e:
+        raise SystemExit(f"kage.ppo.train: config '{path}' ({label}): {e}") from None
+    rundir.check_env(specs, label, env)
+    return env
+
+
+def open_run_dir(run: Run) -> None:
+    """The run's directory, locked, then created or checked against the Specs its batches run."""
+    run.dir = rundir.RunDir.open(run.args, configs_of(run.args), run.specs)
 
 
 def check_pack(runs: List[Args]) -> Args:

@@ -1,0 +1,70 @@
+"""kage.ppo.train checks every argument against its meaning (kage-ppo-baseline.md §2.1) and everything the
+run needs (the device, the agent and augmentation modules, the batches' size) before it writes anything, so
+that a corrected rerun is never refused as "started with other arguments"; nonsense values are refused
+instead of training to "done"."""
+import json
+
+import pytest
+import torch
+
+from kage.ppo import train
+from support import NOISY_SKELETON
+
+BASE = ["--train-config-path", NOISY_SKELETON, "--seed", "3", "--threads", "1", "--total-timesteps", "32",
+        "--num-envs", "2", "--num-steps", "16", "--num-minibatches", "2", "--update-epochs", "1",
+        "--run-eval-every", "0"]
+
+
+@pytest.mark.parametrize("flags", [
+    ["--max-grad-norm", "-1"], ["--max-grad-norm", "0"], ["--max-grad-norm", "nan"],
+    ["--gamma", "2"], ["--gamma", "-0.1"], ["--gamma", "nan"],
+    ["--gae-lambda", "1.5"], ["--learning-rate", "inf"], ["--learning-rate", "0"], ["--learning-rate", "-1e-3"],
+    ["--learning-rate", "nan"], ["--clip-coef", "0"], ["--clip-coef", "-0.2"], ["--ent-coef", "nan"],
+    ["--ent-coef", "-0.01"], ["--vf-coef", "-1"], ["--vf-coef", "inf"], ["--update-epochs", "0"],
+    ["--num-minibatches", "0"], ["--num-minibatches", "-2"], ["--total-timesteps", "-5"],
+    ["--reward-clip-min", "1", "--reward-clip-max", "0"], ["--reward-clip-min", "nan"], ["--seed", "-1"],
+    ["--seed", str(2**64)], ["--save-checkpoint-every", "-1"], ["--threads", "0"], ["--threads", "-2"],
+    ["--num-envs", str(2**31)], ["--eval-num-envs", str(2**31)], ["--num-steps", str(2**40)],
+], ids=lambda flags: " ".join(flags))
+def test_nonsense_values_are_refused_before_anything_is_written(tmp_path, flags):
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as caught:
+        train.main(BASE + ["--device", "cpu", "--out", str(out), *flags])
+    assert caught.value.code != 0
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("first, fix", [
+    (["--agent", "no_such_module:make"], []),
+    (["--agent", "kage.ppo.agent:no_such_factory"], []),
+    (["--augment", "kage.ppo.augment:no_such_fn"], []),
+    (["--num-envs", "100000000", "--num-minibatches", "1", "--total-timesteps", "1600000000"], []),
+], ids=["agent-module", "agent-factory", "augment", "memory"])
+def test_a_refused_run_writes_nothing_and_its_corrected_rerun_trains(tmp_path, first, fix):
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit):
+        train.main(BASE + ["--device", "cpu", "--out", str(out), *first])
+    assert not out.exists()
+    assert train.main(BASE + ["--device", "cpu", "--out", str(out), *fix]) == 0
+    assert json.loads((out / "run.json").read_text())["args"]["device"] == "cpu"
+
+
+def test_the_default_cuda_device_without_a_gpu_writes_nothing(tmp_path):
+    if torch.cuda.is_available():
+        pytest.skip("reported skip: this machine has a GPU, so --device cuda is not refused here")
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit, match="--device cpu"):
+        train.main(BASE + ["--out", str(out)])
+    assert not out.exists()
+    assert train.main(BASE + ["--device", "cpu", "--out", str(out)]) == 0
+
+
+def test_a_pack_file_is_checked_as_the_command_line_is(tmp_path):
+    runs = [vars(train.parse_args(BASE + ["--device", "cpu", "--out", str(tmp_path / f"run{i}")])) for i in (1, 2)]
+    for run in runs:
+        run["gamma"] = 2.0  # both: packed runs that differ in it are refused for that reason
+    pack = tmp_path / "pack.json"
+    pack.write_text(json.dumps({"runs": runs}))
+    with pytest.raises(SystemExit):
+        train.main(["--pack", str(pack)])
+    assert not (tmp_path / "run1").exists() and not (tmp_path / "run2").exists()
