@@ -3,10 +3,13 @@
 #include <dlfcn.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <mutex>
 
 namespace kage {
 namespace {
+
+namespace fs = std::filesystem;
 
 std::mutex& dirs_mutex() {
   static std::mutex m;
@@ -52,6 +55,17 @@ std::vector<std::string> nvrtc_candidates() {
 
 void* open_nvrtc() {
   for (const std::string& c : nvrtc_candidates()) {
+    const fs::path path(c);
+    std::error_code ec;
+    if (path.has_parent_path() && !fs::exists(path, ec)) continue;
+    // NVRTC opens its builtins library (libnvrtc-builtins.so.<major.minor>) by name when it compiles: from
+    // a folder off the loader's path (the wheel's), load it first so that that name is already loaded.
+    if (path.has_parent_path()) {
+      for (const auto& e : fs::directory_iterator(path.parent_path(), ec)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind("libnvrtc-builtins.so.", 0) == 0) ::dlopen(e.path().c_str(), RTLD_NOW | RTLD_LOCAL);
+      }
+    }
     if (void* h = ::dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL)) return h;
   }
   return nullptr;
