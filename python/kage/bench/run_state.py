@@ -38,9 +38,26 @@ def last_error(log_path: str) -> str:
     return lines[-1][:500] if lines else "(the log is empty)"
 
 
+class Damaged(Exception):
+    """A state file that exists but is not one (not JSON, or without its keys): what is wrong with it."""
+
+
+# The keys every state has, with their types; the others depend on the state.
+_REQUIRED = {"state": str, "time": (int, float), "host": str}
+
+
 def read(run_dir: str) -> Optional[dict]:
+    """The run's state, None where it has none; Damaged for a file that is not a state."""
     try:
         with open(os.path.join(run_dir, STATE_FILE)) as f:
-            return json.load(f)
-    except (OSError, ValueError):
+            state = json.load(f)
+    except FileNotFoundError:
         return None
+    except (OSError, ValueError) as e:
+        raise Damaged(str(e)) from None
+    if not isinstance(state, dict):
+        raise Damaged(f"a JSON {type(state).__name__}, not an object")
+    for key, kind in _REQUIRED.items():
+        if not isinstance(state.get(key), kind) or isinstance(state.get(key), bool):
+            raise Damaged(f"no valid '{key}'")
+    return state

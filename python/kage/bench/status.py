@@ -17,9 +17,13 @@ def classify(path: str, now: float) -> tuple:
     """(category, detail) of one run directory."""
     if os.path.exists(os.path.join(path, "summary.json")):
         return "done", ""
-    state = run_state.read(path)
     iteration = checkpoint_iteration(path)
     at = f"checkpoint at iteration {iteration}" if iteration else "no checkpoint yet"
+    try:
+        state = run_state.read(path)
+    except run_state.Damaged as e:
+        return "interrupted", (f"{os.path.join(path, run_state.STATE_FILE)} is damaged ({e}); it is rewritten when "
+                               f"the run runs again; {at}")
     if state is None:
         return ("interrupted", at) if iteration else ("not started", "")
     where = f"host {state['host']}" + (f", task {state['task']}" if state.get("task") is not None else "") + \
@@ -29,7 +33,8 @@ def classify(path: str, now: float) -> tuple:
     if state["state"] == "running" and age <= run_state.STALE_S:
         return "running", f"{at}; {where}"
     if state["state"] == "failed":
-        return "failed", f"exit {state['exit_code']} ({where}, log {state['log']}): {state['error']}"
+        return "failed", (f"exit {state.get('exit_code', '?')} ({where}, log {state.get('log', '?')}): "
+                          f"{state.get('error', '?')}")
     if state["state"] == "running":
         return "interrupted", f"no heartbeat for {age / 60:,.0f} min (killed?); {at}; {where}"
     if state["state"] == "stopped":

@@ -172,6 +172,8 @@ def validate(args: Args) -> List[str]:
         problems.append("--train-config-path is required")
     if args.eval_config_path and args.eval_config_paths:
         problems.append("give --eval-config-path or --eval-config-paths, not both")
+    if args.out and os.path.exists(args.out) and not os.path.isdir(args.out):
+        problems.append(f"--out {args.out}: exists and is not a directory: choose another --out")
     if args.device not in ("cuda", "cpu"):
         problems.append(f"--device {args.device}: use cuda or cpu")
     if args.num_envs <= 0 or args.num_steps <= 0:

@@ -79,7 +79,7 @@ def load(path: str) -> dict:
         older = ("; a checkpoint of an older kage.ppo.train (a pickled dict) reads as data only with torch 2.x"
                  if int(torch.__version__.split(".")[0]) < 2 else "")
         raise CheckpointError(
-            f"{path}: cannot be read as data only ({type(e).__name__}: {str(e).splitlines()[0][:160]}): it is damaged, "
+            f"{path}: cannot be read as data only ({reason(e)}): it is damaged, "
             "is not a kage.ppo.train checkpoint, or holds Python objects that only unpickling would rebuild, which "
             f"can run code{older}") from None
     if isinstance(raw, dict) and raw.get("format") == FORMAT:
@@ -88,6 +88,14 @@ def load(path: str) -> dict:
         return raw  # the pickled dict of earlier versions, which the data-only loader could read
     found = f"format {raw.get('format')!r}" if isinstance(raw, dict) and "format" in raw else type(raw).__name__
     raise CheckpointError(f"{path}: not a kage.ppo.train checkpoint ({found}, expected {FORMAT})")
+
+
+def reason(e: Exception) -> str:
+    """The gist of torch.load's error: the data-only loader's own words where it gave them, else its first line."""
+    text = str(e)
+    gist = text.split("WeightsUnpickler error:", 1)[1] if "WeightsUnpickler error:" in text else text
+    lines = [line.strip() for line in gist.splitlines() if line.strip()]
+    return f"{type(e).__name__}: {lines[0][:120] if lines else 'no detail'}"
 
 
 def _decode(path: str, raw: dict) -> dict:

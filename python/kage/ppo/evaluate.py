@@ -26,7 +26,7 @@ from kage.ppo import checkpoint, plugins, rundir, video
 from kage.errors import ConfigError
 from kage.util import tables
 from kage.ppo.evaluation import METRICS, EvalSettings, evaluate, evaluation_seed
-from kage.util.files import atomic_write, write_json
+from kage.util.files import atomic_write, os_error_text, write_json
 
 CONFIG_COLUMNS = ("episodes", "return", "length", "success_once", "success", "passed_distance", "progress",
                   "jump_count", "x", "y", "vx_mean", "vy_mean")
@@ -180,6 +180,14 @@ def result_of(file: str, spec: dict, state: dict, options) -> dict:
 
 
 def main(argv: Optional[List[str]] = None) -> int:
+    try:
+        return evaluate_command(argv)
+    except OSError as e:  # an --out or --video the file system refuses
+        raise SystemExit(os_error_text("kage.ppo.evaluate", e, "--out or --video")) from None
+
+
+def evaluate_command(argv: Optional[List[str]]) -> int:
+    """main() without its handling of file-system errors."""
     parser = argparse.ArgumentParser(prog="python3 -m kage.ppo.evaluate", description=__doc__.split("\n\n")[0])
     add_scoring_arguments(parser)
     parser.add_argument("--config", nargs="+", required=True, help="configs to evaluate on (YAML or kagec compile dirs)")

@@ -35,8 +35,9 @@ from typing import Dict, List, Optional, Tuple
 import torch
 
 from kage import front_end, resources
+from kage.errors import ConfigError
 from kage.ppo import checkpoint, plugins
-from kage.util.files import atomic_write, remove_strays, safe, write_json
+from kage.util.files import atomic_write, named_errors, remove_strays, safe, write_json
 from kage.util.lock import DirectoryLock, LockHeld
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
@@ -153,9 +154,10 @@ class RunDir:
                       file=sys.stderr, flush=True)
                 self._warned_not_finite = True
         line = (json.dumps(row, sort_keys=True, allow_nan=False) + "\n").encode()
-        self._log.write(line)
-        self._log.flush()
-        os.fsync(self._log.fileno())
+        with named_errors(self._log.name):
+            self._log.write(line)
+            self._log.flush()
+            os.fsync(self._log.fileno())
         self._log_digest.update(line)
         self._log_bytes, self._log_rows = self._log_bytes + len(line), self._log_rows + 1
         return row
@@ -203,8 +205,7 @@ class RunDir:
         try:
             state = checkpoint.load(path)
         except checkpoint.CheckpointError as e:
-            raise SystemExit(f"kage.ppo.train: {e}\nkage.ppo.train: restore it, or train anew with another --out") \
-                from None
+            raise SystemExit(f"kage.ppo.train: {e}; restore it, or train anew with another --out") from None
         self._check_identity(path, state)
         self._restart_log(state["log"], state["iteration"])
         return state
@@ -251,15 +252,32 @@ def resolve_configs(configs: List[Tuple[str, str]], asset_root: Optional[str]) -
     for label, config in configs:
         if not os.path.exists(config):
             raise SystemExit(f"kage.ppo.train: config '{config}' ({label}) not found")
-        specs[label] = front_end.resolve(config, asset_root)
+        try:
+            specs[label] = front_end.resolve(config, asset_root)
+        except ConfigError as e:
+            raise SystemExit(f"{e}\nkage.ppo.train: config '{config}' ({label}) has the errors above: fix the config "
+                             "first") from None
     return specs, {label: {"path": config, "spec_sha256": specs[label]["sha256"]} for label, config in configs}
 
 
 def check_finished(path: str, args, configs: List[Tuple[str, str]]) -> None:
     """Refuses a finished run's directory to other arguments or changed configs, as a resume would (reads only)."""
-    with open(os.path.join(path, "run.json")) as f:
-        previous = json.load(f)
+    previous = read_run_json(os.path.join(path, "run.json"))
     check_same_run(path, previous, json_args(args), resolve_configs(configs, args.asset_root)[1])
+
+
+def read_run_json(path: str) -> dict:
+    """A run's run.json, refused by name where it is not JSON or lacks what a run records."""
+    try:
+        with open(path) as f:
+            run = json.load(f)
+        problem = None if isinstance(run, dict) and isinstance(run.get("args"), dict) and \
+            isinstance(run.get("configs"), dict) else "it lacks the run's arguments and configs"
+    except ValueError as e:
+        problem = f"not JSON ({e})"
+    if problem:
+        raise SystemExit(f"kage.ppo.train: {path}: {problem}: restore it from a copy, or train anew with another --out")
+    return run
 
 
 def describe_or_check(path: str, args, configs: List[Tuple[str, str]], specs: Dict[str, dict],
@@ -270,9 +288,7 @@ def describe_or_check(path: str, args, configs: List[Tuple[str, str]], specs: Di
         remove_strays(os.path.join(path, folder))  # a killed writer's, or one that met a full disk
     run_json = os.path.join(path, "run.json")
     if os.path.exists(run_json):
-        with open(run_json) as f:
-            previous = json.load(f)
-        check_same_run(path, previous, json_args(args), described)
+        check_same_run(path, read_run_json(run_json), json_args(args), described)
         return
     log = os.path.join(path, "metrics.jsonl")
     if os.path.exists(os.path.join(path, "checkpoints", "latest.pt")) or (os.path.exists(log) and os.path.getsize(log)):

@@ -47,7 +47,7 @@ from kage.ppo.evaluation import METRICS, EpisodeMetrics, EvalSettings, EvalTarge
 from kage.ppo.losses import clip_grad_norm_per_run, compute_gae, entropy_coefficient, entropy_of, ppo_loss
 from kage.ppo.policy import RolloutPolicy, autocast
 from kage.ppo.wrappers import FrameStack, RewardNormalizer
-from kage.util.files import safe
+from kage.util.files import os_error_text, safe
 from kage.util.stop import StopRequest, die_with_parent
 
 ACTION_STREAM, SHUFFLE_STREAM = 1, 2  # the two random streams of a run (§2.4); evaluations use their own keys
@@ -498,6 +498,14 @@ def train_rows(measured: List[Dict[str, object]], iteration: int, global_step: i
 
 def main(argv: Optional[List[str]] = None) -> int:
     die_with_parent()  # under kage.bench run: its death (even SIGKILL) stops this trainer too
+    try:
+        return train_command(argv)
+    except OSError as e:  # a file system that refuses writes: read-only, full, no permission
+        raise SystemExit(os_error_text("kage.ppo.train", e, "--out")) from None
+
+
+def train_command(argv: Optional[List[str]]) -> int:
+    """main() without its handling of file-system errors."""
     parsed = parse_args(argv)
     pack = parsed if isinstance(parsed, list) else [parsed]
     unfinished = []

@@ -6,6 +6,7 @@ The content goes to a temporary file beside the target, NAME.tmp.<host>.<pid>.<r
 unpredictable, removed when the write fails (a full disk keeps no stray), and named by its writer, so that
 remove_strays can tell a dead writer's leftovers from a live one's (processes of several hosts may share a
 directory: a Slurm array)."""
+import contextlib
 import errno
 import json
 import os
@@ -20,16 +21,41 @@ _TEMPORARY = re.compile(r"^.+\.tmp\.(?P<host>[^/]+?)\.(?P<pid>\d+)(?:\.[0-9a-f]+
 
 def atomic_write(path: str, data: bytes) -> None:
     """Writes `data` to a new temporary file beside `path`, syncs it, then renames it over `path`."""
-    name, fd = create_temporary(path)
+    with named_errors(path):
+        name, fd = create_temporary(path)
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(name, path)
+        except BaseException:
+            _unlink(name)
+            raise
+
+
+@contextlib.contextmanager
+def named_errors(path: str):
+    """OSErrors of the block that name no file (a write's or fsync's ENOSPC) name `path`."""
     try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(name, path)
-    except BaseException:
-        _unlink(name)
+        yield
+    except OSError as e:
+        if e.filename is None:
+            raise OSError(e.errno, e.strerror, path) from e
         raise
+
+
+def os_error_text(program: str, e: OSError, flag: str) -> str:
+    """One line for a file system's refusal: the file, the reason, and what to do (`flag`: the option that
+    chose where to write)."""
+    where = e.filename if e.filename is not None else "?"
+    if e.errno in (errno.ENOSPC, errno.EDQUOT):
+        fix = "free space on that file system (or raise the quota), then run the same command again: it resumes"
+    elif e.errno in (errno.EROFS, errno.EACCES, errno.EPERM):
+        fix = f"choose a writable {flag}"
+    else:
+        fix = f"check that path (or choose another {flag}), then run the same command again"
+    return f"{program}: {where}: {e.strerror or e}: {fix}"
 
 
 def create_temporary(path: str):

@@ -20,7 +20,7 @@ import threading
 import time
 from typing import Optional
 
-from kage.util.files import create_temporary, process_alive
+from kage.util.files import create_temporary, named_errors, process_alive
 
 HEARTBEAT_S = 30.0
 STALE_S = 4 * HEARTBEAT_S
@@ -130,10 +130,14 @@ class DirectoryLock:
 
     def _written_temporary(self, data: bytes) -> str:
         name, fd = create_temporary(self.path)
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
+        try:
+            with named_errors(self.path), os.fdopen(fd, "wb") as f:
+                f.write(data)
+                f.flush()
+                os.fsync(f.fileno())
+        except BaseException:
+            os.unlink(name)
+            raise
         return name
 
     def _create(self, path: Optional[str] = None) -> bool:

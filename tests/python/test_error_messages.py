@@ -1,0 +1,153 @@
+"""What a user can get wrong ends in a message, not a traceback: a config with errors inside kage.ppo.train, an
+--out that is a file or on a read-only or full file system (the OSErrors injected: CI runs as root, where
+permission bits stop nothing), a truncated or garbage checkpoint, a run.json that is not JSON, and a damaged
+bench_state.json, which must not abort kage.bench status for the other runs. Each message names the file,
+what is wrong and the fix."""
+import errno
+import io
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from kage.bench import status
+from kage.ppo import train
+from support import CONFIGS, NOISY_SKELETON, ROOT
+
+FLAGS = ["--train-config-path", NOISY_SKELETON, "--device", "cpu", "--threads", "1", "--total-timesteps", "64",
+         "--num-envs", "2", "--num-steps", "16", "--num-minibatches", "2", "--update-epochs", "1",
+         "--run-eval-every", "0", "--save-checkpoint-every", "1", "--seed", "6"]
+
+
+def command(module, *args):
+    return subprocess.run([sys.executable, "-m", module, *args], cwd=ROOT, capture_output=True, text=True, timeout=600)
+
+
+def one_message(done, *names):
+    """The command failed with a message (no traceback) whose last line names each of `names`."""
+    assert done.returncode != 0, done.stderr
+    assert "Traceback" not in done.stderr, done.stderr
+    last = done.stderr.strip().splitlines()[-1]
+    for name in names:
+        assert name in last, done.stderr
+    return last
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    out = tmp_path_factory.mktemp("runs") / "run"
+    assert train.main(FLAGS + ["--out", str(out)]) == 0
+    return out
+
+
+def test_a_config_with_errors(tmp_path):
+    done = command("kage.ppo.train", *FLAGS, "--train-config-path", str(CONFIGS / "bad_value.yaml"),
+                   "--out", str(tmp_path / "run"))
+    one_message(done, "fix the config")
+    assert "bad_value.yaml:" in done.stderr  # kagec's located diagnostic
+    assert not (tmp_path / "run").exists()
+
+
+def test_an_out_that_is_a_file(tmp_path):
+    (tmp_path / "taken").write_text("a file")
+    one_message(command("kage.ppo.train", *FLAGS, "--out", str(tmp_path / "taken")), str(tmp_path / "taken"),
+                "--out")
+
+
+def test_an_evaluation_out_that_is_a_file(tmp_path, finished):
+    (tmp_path / "taken").write_text("a file")
+    one_message(command("kage.ppo.evaluate", str(finished), "--config", NOISY_SKELETON, "--out", str(tmp_path / "taken"),
+                        "--device", "cpu", "--episodes", "1", "--num-envs", "2"), str(tmp_path / "taken"), "--out")
+
+
+def failing(error, under):
+    """os.open and os.mkdir raising `error` for paths under `under`, and behaving otherwise."""
+    real_open, real_mkdir = os.open, os.mkdir
+
+    def check(path):
+        if os.path.abspath(os.fspath(path)).startswith(str(under)):
+            raise OSError(error, os.strerror(error), os.fspath(path))
+
+    def fake_open(path, *args, **kwargs):
+        check(path)
+        return real_open(path, *args, **kwargs)
+
+    def fake_mkdir(path, *args, **kwargs):
+        check(path)
+        return real_mkdir(path, *args, **kwargs)
+    return fake_open, fake_mkdir
+
+
+@pytest.mark.parametrize("error, fix", [(errno.EROFS, "writable"), (errno.ENOSPC, "free space"),
+                                        (errno.EACCES, "writable")])
+@pytest.mark.parametrize("existing", [False, True], ids=["new", "resume"])
+def test_a_file_system_that_refuses_writes(tmp_path, monkeypatch, finished, error, fix, existing):
+    out = tmp_path / "run"
+    if existing:
+        shutil.copytree(finished, out)
+        (out / "summary.json").unlink()
+    fake_open, fake_mkdir = failing(error, out)
+    monkeypatch.setattr(os, "open", fake_open)
+    monkeypatch.setattr(os, "mkdir", fake_mkdir)
+    with pytest.raises(SystemExit) as caught:
+        train.main(FLAGS + ["--out", str(out)])
+    message = str(caught.value)
+    assert "\n" not in message and str(out) in message and os.strerror(error) in message and fix in message, message
+
+
+def test_a_full_disk_while_checkpointing(tmp_path, monkeypatch):
+    out = tmp_path / "run"
+
+    def full(fd):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "fsync", full)
+    with pytest.raises(SystemExit) as caught:
+        train.main(FLAGS + ["--out", str(out)])
+    message = str(caught.value)
+    assert "\n" not in message and str(out) in message and "free space" in message, message
+
+
+@pytest.mark.parametrize("damage", [lambda data: data[:len(data) // 2], lambda data: b"garbage" * 100, lambda data: b""],
+                         ids=["truncated", "garbage", "empty"])
+def test_a_damaged_checkpoint(tmp_path, finished, damage):
+    run = tmp_path / "run"
+    shutil.copytree(finished, run)
+    latest = run / "checkpoints" / "latest.pt"
+    latest.write_bytes(damage(latest.read_bytes()))
+    one_message(command("kage.ppo.evaluate", str(run), "--config", NOISY_SKELETON, "--out", str(tmp_path / "eval"),
+                        "--device", "cpu", "--episodes", "1", "--num-envs", "2"), "latest.pt")
+    (run / "summary.json").unlink()
+    one_message(command("kage.ppo.train", *FLAGS, "--out", str(run)), "latest.pt", "another --out")
+
+
+@pytest.mark.parametrize("text", ["{not json", "[]", '{"args": 3}', ""], ids=["syntax", "list", "shape", "empty"])
+def test_a_run_json_that_is_not_a_run_description(tmp_path, finished, text):
+    run = tmp_path / "run"
+    shutil.copytree(finished, run)
+    (run / "run.json").write_text(text)
+    one_message(command("kage.ppo.train", *FLAGS, "--out", str(run)), "run.json")
+    (run / "summary.json").unlink()
+    one_message(command("kage.ppo.train", *FLAGS, "--out", str(run)), "run.json")
+
+
+def test_a_damaged_bench_state_does_not_abort_status(tmp_path):
+    bench = tmp_path / "bench"
+    runs = {"good": {"state": "failed", "time": 0, "host": "h", "exit_code": 1, "log": "x.log", "error": "boom"},
+            "list": [], "syntax": "{", "no_time": {"state": "running", "host": "h"},
+            "text_time": {"state": "running", "time": "yesterday", "host": "h"}, "no_host": {"state": "stopped", "time": 0}}
+    for unit, content in runs.items():
+        (bench / "runs" / unit / "seed_1").mkdir(parents=True)
+        state = bench / "runs" / unit / "seed_1" / "bench_state.json"
+        state.write_text(content if isinstance(content, str) else json.dumps(content))
+    (bench / "bench.json").write_text(json.dumps({"units": list(runs), "seeds": [1]}))
+    out = io.StringIO()
+    found = status.status(str(bench), out)
+    assert found["failed"] == ["good seed 1"]
+    text = out.getvalue()
+    for unit in ("list", "syntax", "no_time", "text_time", "no_host"):
+        line = next(line for line in text.splitlines() if f"{unit} seed 1" in line)
+        assert "bench_state.json" in line and "rewritten" in line, line
