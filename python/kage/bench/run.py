@@ -62,6 +62,11 @@ def parse_seeds(text: str) -> List[int]:
     return sorted(set(seeds))
 
 
+# The trainer flags kage.bench sets for each run (the trainer's parser takes no abbreviations of them).
+PER_RUN_FLAGS = ("--train-config-path", "--eval-config-path", "--eval-config-paths", "--eval-config-labels",
+                 "--seed", "--out", "--exp-name")
+
+
 def units_to_train(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
     """The suite's pairs and sweeps, in manifest order, or the `wanted` ones; refuses configs written inline."""
     for p in report["pairs"]:
@@ -69,6 +74,17 @@ def units_to_train(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
             raise SystemExit(f"kage.bench: pair {p['pair']} writes a config inline in the manifest; "
                              "kage.bench trains only configs in files: move it to a file")
     return select(units_of(report), wanted, "kage.bench")
+
+
+def check_unit_name(name: str) -> None:
+    """Refuses a pair or sweep name that would not be a folder inside DIR/runs/ (absolute, "..", ".", an empty
+    part, a backslash or a control character), since its runs are written under DIR/runs/<name>/."""
+    parts = name.split("/")
+    if not name or name.startswith("/") or "\\" in name or any(p in ("", ".", "..") for p in parts) or \
+            any(ord(c) < 32 or ord(c) == 127 for c in name):
+        raise SystemExit(f"kage.bench: pair or sweep name {name!r}: its runs go to DIR/runs/<name>/, so the name must "
+                         "be a relative path of plain parts (no leading '/', no '.' or '..' parts, no empty part, no "
+                         "backslash or control character): rename it in the suite")
 
 
 MAX_EVALS = 10  # eval configs per run (kage.ppo.train's limit, §3.5)
@@ -279,9 +295,8 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
     starts."""
     if args.pack < 1:
         raise SystemExit(f"kage.bench: --pack {args.pack}: a positive number of runs per process")
-    for flag in ("--train-config-path", "--eval-config-path", "--eval-config-paths", "--eval-config-labels",
-                 "--seed", "--out", "--exp-name"):
-        if flag in trainer_args:
+    for flag in PER_RUN_FLAGS:
+        if any(arg == flag or arg.startswith(flag + "=") for arg in trainer_args):
             raise SystemExit(f"kage.bench: {flag} is set per run by kage.bench; remove it")
     from kage.ppo import train
     probe = train.parse_args(["--train-config-path", args.suite, *trainer_args])  # trainer flags checked now
@@ -298,6 +313,8 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
     units = units_to_train(report, args.pairs)
     if args.share_training:
         units = share_training(units, report)
+    for unit in units:
+        check_unit_name(unit.name)
     for p in report["pairs"]:
         if not p["certified"] and any(p["pair"] == q["pair"] for u in units for q in u.pairs):
             print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
@@ -412,7 +429,8 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
 
 def main(argv: List[str]) -> int:
     parser = argparse.ArgumentParser(prog="python3 -m kage.bench run", description=__doc__.split("\n\n")[0],
-                                     epilog="Any other flag is a trainer flag (python3 -m kage.ppo.train --help).")
+                                     epilog="Any other flag is a trainer flag (python3 -m kage.ppo.train --help).",
+                                     allow_abbrev=False)  # --seed is a trainer flag, not --seeds
     add_bench_arguments(parser)
     parser.add_argument("--task", type=int, help="train only task I of DIR/tasks.json (a Slurm array task)")
     parser.add_argument("--gpus", help="'all' or a list like 0,2: one worker process per GPU, each training "

@@ -42,17 +42,39 @@ def package_root() -> str:
     return os.path.dirname(os.path.dirname(os.path.abspath(kage.__file__)))
 
 
+def one_line(value: str, what: str) -> str:
+    """`value` for a line of the script; a newline (or another control character) would end that line and put
+    the rest of the value on a line of its own, which the shell runs: refused."""
+    if any(ord(c) < 32 or ord(c) == 127 for c in value):
+        raise SystemExit(f"kage.bench slurm: {what} {value!r} holds a newline or another control character, which "
+                         "would become a line of the script of its own: rename it")
+    return value
+
+
+def directive(option: str, value: str, what: str) -> str:
+    """#SBATCH's `--option=value`, the value in double quotes (with \\, " and # escaped) where it has spaces or
+    one of those characters: sbatch reads the line's arguments with those rules, so the value stays one."""
+    value = one_line(value, what)
+    if any(c in value for c in ' \t"\\#\''):
+        value = '"' + "".join("\\" + c if c in '"\\#' else c for c in value) + '"'
+    return f"--{option}={value}"
+
+
 def script(bench: run.Bench, table: List[List[tasks.Job]], args: argparse.Namespace) -> str:
     last = len(table) - 1
     limit = f"%{args.array_parallelism}" if args.array_parallelism else ""
     gpus = args.gpus_per_task if args.gpus_per_task is not None else (1 if bench.device == "cuda" else 0)
-    directives = [f"--job-name={args.job_name}", f"--array=0-{last}{limit}", f"--chdir={os.getcwd()}",
-                  f"--output={os.path.join(bench.out, 'slurm', 'task_%a.log')}", "--open-mode=append",
-                  "--ntasks=1", "--requeue"]
+    cwd = one_line(os.getcwd(), "the working directory")
+    one_line(bench.suite, "the suite path")
+    one_line(package_root(), "the package's directory")
+    directives = [directive("job-name", args.job_name, "--job-name"), f"--array=0-{last}{limit}",
+                  directive("chdir", cwd, "the working directory"),
+                  directive("output", os.path.join(bench.out, "slurm", "task_%a.log"), "--out"),
+                  "--open-mode=append", "--ntasks=1", "--requeue"]
     if args.partition:
-        directives.append(f"--partition={args.partition}")
+        directives.append(directive("partition", args.partition, "--partition"))
     if args.time:
-        directives.append(f"--time={args.time}")
+        directives.append(directive("time", args.time, "--time"))
     if gpus:
         directives.append(f"--gpus-per-task={gpus}")
     command = " ".join(map(shlex.quote, bench.run_command()))
@@ -88,7 +110,8 @@ def submit(path: str) -> str:
 
 def main(argv: List[str]) -> int:
     parser = argparse.ArgumentParser(prog="python3 -m kage.bench slurm", description=__doc__.split("\n\n")[1],
-                                     epilog="Any other flag is a trainer flag (python3 -m kage.ppo.train --help).")
+                                     epilog="Any other flag is a trainer flag (python3 -m kage.ppo.train --help).",
+                                     allow_abbrev=False)  # --seed is a trainer flag, not --seeds
     run.add_bench_arguments(parser)
     parser.add_argument("--partition", help="the Slurm partition (default: the cluster's default)")
     parser.add_argument("--time", help="time limit per array task, e.g. 4:00:00 (default: the partition's)")
@@ -104,9 +127,10 @@ def main(argv: List[str]) -> int:
         value = getattr(args, name)
         if value is not None and value < (1 if name == "array_parallelism" else 0):
             raise SystemExit(f"kage.bench slurm: --{name.replace('_', '-')} {value}: out of range")
-    bench = run.prepare(args, absolute_paths(trainer_args))
+    bench = run.plan(args, absolute_paths(trainer_args))
     table = bench.table()
-    text = script(bench, table, args)
+    text = script(bench, table, args)  # its values checked before anything is written
+    run.record(bench)
     path = os.path.join(bench.out, "slurm", "kage_bench.sbatch")
     os.makedirs(os.path.dirname(path), exist_ok=True)
     atomic_write(path, text.encode())

@@ -99,7 +99,8 @@ PER_RUN = ("train_config_path", "eval_config_path", "eval_config_paths", "eval_c
 
 def parse_args(argv: Optional[List[str]] = None) -> Args:
     """The flags of Args: --snake-case names, booleans as --flag / --no-flag."""
-    parser = argparse.ArgumentParser(prog="python3 -m kage.ppo.train", description=DESCRIPTION)
+    # No abbreviations: kage.bench refuses the per-run flags by their full names, which an abbreviation would pass.
+    parser = argparse.ArgumentParser(prog="python3 -m kage.ppo.train", description=DESCRIPTION, allow_abbrev=False)
     for f in dataclasses.fields(Args):
         flag = "--" + f.name.replace("_", "-")
         default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default

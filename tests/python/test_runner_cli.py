@@ -1,0 +1,99 @@
+"""The runner's command line and the Slurm script it writes: the flags kage.bench sets per run are refused in
+every spelling (--flag=value, abbreviations), --seed is not taken for --seeds, #SBATCH values with spaces
+stay one value, a newline in any value written into the script is refused rather than becoming a line of
+its own, and a pair whose name would put its runs outside the benchmark directory is refused."""
+import os
+import subprocess
+import sys
+
+import pytest
+
+from kage.bench import run, slurm
+from support import NOISY_SKELETON, TINY_TRAINING
+
+SUITE = """suite: names
+pairs:
+  - name: {name}
+    axis: background
+    train: {config}
+    eval: {config}
+"""
+
+
+def write_suite(directory, name="alone"):
+    directory.mkdir(parents=True, exist_ok=True)
+    suite = directory / "suite.yaml"
+    suite.write_text(SUITE.format(name=name, config=NOISY_SKELETON))
+    return suite
+
+
+@pytest.mark.parametrize("flags, match", [
+    (["--eval-config-path=/elsewhere.yaml"], "--eval-config-path"),
+    (["--eval-config-paths=/a.yaml"], "--eval-config-paths"),
+    (["--train-config-path=/x.yaml"], "--train-config-path"),
+    (["--seed", "4"], "--seed"),
+    (["--seed=4"], "--seed"),
+    (["--exp-name=x"], "--exp-name"),
+    (["--eval-config-p", "/elsewhere.yaml"], "eval-config-p"),
+    (["--see", "4"], "see"),
+])
+@pytest.mark.parametrize("command", ["run", "slurm"])
+def test_per_run_flags_are_refused_in_every_spelling(tmp_path, flags, match, command):
+    suite = write_suite(tmp_path)
+    main = run.main if command == "run" else slurm.main
+    with pytest.raises(SystemExit) as caught:
+        main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *TINY_TRAINING, *flags])
+    assert caught.value.code != 0
+    assert not (tmp_path / "bench" / "bench.json").exists()
+
+
+def sbatch_lines(script: str):
+    return [line for line in script.splitlines() if line.startswith("#SBATCH ")]
+
+
+def write_script(tmp_path, *args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "kage.bench", "slurm", *args, *TINY_TRAINING], cwd=cwd or tmp_path,
+                          capture_output=True, text=True, timeout=600,
+                          env=dict(os.environ, PYTHONPATH=os.environ.get("PYTHONPATH", "")))
+
+
+def test_sbatch_values_with_spaces_stay_one_value(tmp_path):
+    suite = write_suite(tmp_path / "my suites")
+    out = tmp_path / "my runs"
+    done = write_script(tmp_path, str(suite), "--seeds", "1", "--out", str(out), "--job-name", "my job",
+                        "--partition", "gpu", "--time", "4:00:00")
+    assert done.returncode == 0, done.stderr
+    lines = sbatch_lines((out / "slurm" / "kage_bench.sbatch").read_text())
+    assert f'#SBATCH --output="{out}/slurm/task_%a.log"' in lines
+    assert '#SBATCH --job-name="my job"' in lines
+    assert "#SBATCH --partition=gpu" in lines and "#SBATCH --time=4:00:00" in lines
+
+
+@pytest.mark.parametrize("flag", ["--job-name", "--partition", "--time"])
+def test_a_newline_in_a_slurm_value_is_refused(tmp_path, flag):
+    suite = write_suite(tmp_path)
+    done = write_script(tmp_path, str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), flag,
+                        "x\ntouch /tmp/injected")
+    assert done.returncode != 0 and flag in done.stderr and "Traceback" not in done.stderr, done.stderr
+    assert not (tmp_path / "bench" / "slurm" / "kage_bench.sbatch").exists()
+
+
+def test_a_newline_in_out_the_suite_path_or_the_working_directory_is_refused(tmp_path):
+    suite = write_suite(tmp_path)
+    odd = write_suite(tmp_path / "odd\necho injected")
+    cases = [([str(suite), "--out", str(tmp_path / "b\nrm -rf x")], tmp_path, "--out"),
+             ([str(odd), "--out", str(tmp_path / "b2")], tmp_path, "suite"),
+             ([str(suite), "--out", str(tmp_path / "b3")], tmp_path / "odd\necho injected", "working directory")]
+    for args, cwd, what in cases:
+        done = write_script(tmp_path, *args, "--seeds", "1", cwd=cwd)
+        assert done.returncode != 0 and what in done.stderr and "Traceback" not in done.stderr, done.stderr
+        assert "newline" in done.stderr
+
+
+@pytest.mark.parametrize("name", ["/tmp/escaped", "../escaped", "a/../../escaped", "a//b", "./a", "a\\b"])
+def test_a_pair_named_outside_the_benchmark_directory_is_refused(tmp_path, name):
+    suite = write_suite(tmp_path, f'"{name}"')
+    with pytest.raises(SystemExit, match="name"):
+        run.main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *TINY_TRAINING])
+    assert not (tmp_path / "bench").exists()
+    assert not (tmp_path / "escaped").exists() and not os.path.exists("/tmp/escaped/seed_1")
