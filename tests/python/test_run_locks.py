@@ -24,9 +24,10 @@ pairs:
     eval: {config}
 """
 # Thousands of 32-step iterations: a run that is still training when the test looks at it.
-LONG = ["--train-config-path", NOISY_SKELETON, "--seed", "1", "--device", "cpu", "--threads", "1",
-        "--total-timesteps", "640000", "--num-envs", "2", "--num-steps", "16", "--num-minibatches", "2",
-        "--update-epochs", "1", "--run-eval-every", "0", "--save-checkpoint-every", "2"]
+# kage.bench run sets the config and the seed of each run itself, so it gets TRAINING alone.
+TRAINING = ["--device", "cpu", "--threads", "1", "--total-timesteps", "640000", "--num-envs", "2",
+            "--num-steps", "16", "--num-minibatches", "2", "--update-epochs", "1", "--run-eval-every", "0", "--save-checkpoint-every", "2"]
+LONG = ["--train-config-path", NOISY_SKELETON, "--seed", "1", *TRAINING]
 
 
 def start(module, *args, **popen):
@@ -155,7 +156,7 @@ def write_suite(tmp_path):
 
 def test_a_second_benchmark_runner_on_a_directory_refuses(tmp_path):
     suite, out = write_suite(tmp_path), tmp_path / "bench"
-    flags = [str(suite), "--seeds", "1", "--out", str(out), *LONG[2:]]
+    flags = [str(suite), "--seeds", "1", "--out", str(out), *TRAINING]
     first = start("kage.bench", "run", *flags)
     try:
         wait_for(lambda: len(train_rows(out / "runs" / "alone" / "seed_1")) >= 1, "the first runner's training")
@@ -170,7 +171,7 @@ def test_a_second_benchmark_runner_on_a_directory_refuses(tmp_path):
 
 def test_killing_the_runners_process_group_stops_its_trainer(tmp_path):
     suite, out = write_suite(tmp_path), tmp_path / "bench"
-    runner = start("kage.bench", "run", str(suite), "--seeds", "1", "--out", str(out), *LONG[2:],
+    runner = start("kage.bench", "run", str(suite), "--seeds", "1", "--out", str(out), *TRAINING,
                    start_new_session=True)
     run_lock = out / "runs" / "alone" / "seed_1" / "run.lock"
     wait_for(lambda: len(train_rows(out / "runs" / "alone" / "seed_1")) >= 1, "the trainer")
