@@ -2,7 +2,7 @@
 // They pin the original's conventions: round half to even, floored modulo, clip = min(max(v, lo), hi).
 #pragma once
 
-#include "kage_hd.h"
+#include "runtime/kage_hd.h"
 
 #if !defined(__CUDACC__)
 #include <cmath>

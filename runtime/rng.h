@@ -6,7 +6,7 @@
 // The samplers follow the original's float32 formulas (spec Appendix A.4).
 #pragma once
 
-#include "kage_hd.h"
+#include "runtime/kage_hd.h"
 
 namespace kage {
 
@@ -17,7 +17,7 @@ struct Key {
 
 enum class Stream : uint32_t {
 #define KAGE_STREAM(name, id, doc) name = id,
-#include "streams.def"
+#include "runtime/streams.def"
 #undef KAGE_STREAM
 };
 

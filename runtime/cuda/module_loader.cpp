@@ -86,8 +86,10 @@ std::optional<std::string> cache_lookup(const fs::path& file, const std::string&
 }  // namespace
 
 std::vector<std::string> nvrtc_option_list(const std::string& arch, const NvrtcOptions& options) {
+  // --no-source-include: quoted includes come from include_dir alone, never from the working directory (a
+  // checkout's runtime/ beside an installed one would otherwise mix two copies of the headers).
   std::vector<std::string> opts = {"--gpu-architecture=" + arch, "-std=c++20", "--fmad=false",
-                                   "-I" + options.include_dir};
+                                   "--no-source-include", "-I" + options.include_dir};
   opts.insert(opts.end(), options.extra_options.begin(), options.extra_options.end());
   return opts;
 }

@@ -2,11 +2,16 @@
 // (tests/codegen/simplest.expected.cu, which the codegen golden test keeps equal to the generator's
 // output; it includes runtime/cuda/kernels.cuh) with the loader's own option list for sm_90. NVRTC is a
 // library, so this runs without a GPU. Exit 1 with the NVRTC log when the source does not compile, or
-// when the cubin lacks one of the entry points the device batch looks up.
+// when the cubin lacks one of the entry points the device batch looks up. Compiled twice: from the source
+// root, then from a folder whose own runtime/ headers fail, so that a checkout in the working directory
+// can never shadow the include root the loader names (an installed package run from a checkout).
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include <unistd.h>
 
 #include "runtime/cuda/module_loader.h"
 
@@ -23,10 +28,24 @@ int main() {
   kage::NvrtcOptions options;
   options.include_dir = root;
   std::string error;
-  const std::optional<std::string> cubin =
+  std::optional<std::string> cubin =
       kage::nvrtc_compile(text.str(), "simplest.expected.cu", kage::nvrtc_option_list("sm_90", options), &error);
   if (!cubin) {
     std::fprintf(stderr, "NVRTC could not compile %s:\n%s\n", path.c_str(), error.c_str());
+    return 1;
+  }
+  namespace fs = std::filesystem;
+  const fs::path decoy = fs::temp_directory_path() / ("kage_nvrtc_decoy_" + std::to_string(::getpid()));
+  fs::create_directories(decoy / "runtime" / "cuda");
+  std::ofstream(decoy / "runtime" / "cuda" / "kernels.cuh") << "#error \"read from the working directory\"\n";
+  const fs::path source_dir = fs::current_path();
+  fs::current_path(decoy);
+  const std::optional<std::string> from_elsewhere =
+      kage::nvrtc_compile(text.str(), "simplest.expected.cu", kage::nvrtc_option_list("sm_90", options), &error);
+  fs::current_path(source_dir);
+  fs::remove_all(decoy);
+  if (!from_elsewhere) {
+    std::fprintf(stderr, "NVRTC read headers outside the include root %s:\n%s\n", root.c_str(), error.c_str());
     return 1;
   }
   // Each kernel has its own code section, named after its unmangled extern "C" name.
