@@ -75,6 +75,7 @@ ffi::Error step(CpuInstance* instance, std::string_view, ffi::RemainingArgs args
   const ffi::ErrorOr<EnvBuffers> got = step_buffers(c, args, rets);
   if (!got.has_value()) return got.error();
   const EnvBuffers& b = *got;
+  for (size_t i = 0; i < b.copy_count; ++i) std::memcpy(b.copies[i].to, b.copies[i].from, b.copies[i].bytes);
   const StepRows rows{0, b.reward, b.terminated, b.truncated, b.info, b.final_mask, b.final_info, nullptr, 1};
   for_each_env(c, b, [&](int32_t env, const EnvSlot& slot) {
     StepRows row = rows;

@@ -1,8 +1,8 @@
 // kage.jax's CUDA handlers: the config's specialised kernels (kage_reset, kage_step and kage_render of
 // runtime/cuda/kernels.cuh) launched on the stream XLA passes in, on the buffers XLA owns: the state is
-// updated in place (the step's aliased buffers), outputs are written where XLA put them, and nothing is
-// copied, allocated or waited for. The module and the assets are loaded once per process and config, at
-// the instantiate stage.
+// updated in place (the step's aliased buffers, copied over first where XLA gave a pair two), outputs are
+// written where XLA put them, and nothing is allocated or waited for. The module and the assets are loaded
+// once per process and config, at the instantiate stage.
 //
 // Device 0 only: the runtime's module loader binds to device 0's primary context (the one XLA uses too).
 // A process per GPU (CUDA_VISIBLE_DEVICES) runs on any GPU.
@@ -213,6 +213,15 @@ ffi::Error step(CUstream stream, int32_t ordinal, CudaInstance* instance, std::s
   if (!got.has_value()) return got.error();
   if (got->n > INT32_MAX) return handler_error("kage_step", "more than 2^31 - 1 environments");
   const DeviceProgram& p = *instance->program;
+  std::string error;
+  if (!check(cuCtxSetCurrent(p.context), "cuCtxSetCurrent", &error)) return handler_error("kage_step", error);
+  for (size_t i = 0; i < got->copy_count; ++i) {
+    const InPlaceCopy& copy = got->copies[i];
+    if (!check(cuMemcpyDtoDAsync(reinterpret_cast<CUdeviceptr>(copy.to), reinterpret_cast<CUdeviceptr>(copy.from),
+                                 copy.bytes, stream),
+               "cuMemcpyDtoDAsync", &error))
+      return handler_error("kage_step", error);
+  }
   return launch("kage_step", c, p, p.step, device_envs(c, p, *got), stream);
 }
 

@@ -1,6 +1,7 @@
 // The buffers of kage.jax's FFI calls: counted, checked against the config, turned into row pointers.
 #include "api/jax/ffi_buffers.h"
 
+#include <optional>
 #include <string>
 #include <type_traits>
 
@@ -130,11 +131,19 @@ void take_outputs(Taker& t, const JaxConfig& c, size_t first_state, size_t first
   b->final_mask = t.ret<uint8_t>(first_obs + 4, "final_mask", Elem::kFlag, 1);
 }
 
-/// Whether argument `a` and result `r` are one buffer, as input_output_aliases makes them.
-bool aliased(const ffi::RemainingArgs& args, const ffi::RemainingRets& rets, size_t a, size_t r) {
+/// Argument `a` and result `r`'s buffers when they are not one buffer, to be copied from `a` to `r`; an error
+/// when their sizes differ.
+std::optional<InPlaceCopy> unaliased(const ffi::RemainingArgs& args, const ffi::RemainingRets& rets, size_t a,
+                                     size_t r, std::string* error) {
   ffi::ErrorOr<ffi::AnyBuffer> in = args.get<ffi::AnyBuffer>(a);
   ffi::ErrorOr<ffi::Result<ffi::AnyBuffer>> out = rets.get<ffi::AnyBuffer>(r);
-  return in.has_value() && out.has_value() && in->untyped_data() == (**out).untyped_data();
+  if (!in.has_value() || !out.has_value() || in->size_bytes() != (**out).size_bytes()) {
+    *error = "argument " + std::to_string(a) + " does not match result " + std::to_string(r) +
+             ", which it updates in place";
+    return std::nullopt;
+  }
+  if (in->untyped_data() == (**out).untyped_data()) return std::nullopt;
+  return InPlaceCopy{(**out).untyped_data(), in->untyped_data(), in->size_bytes()};
 }
 
 }  // namespace
@@ -173,13 +182,11 @@ ffi::ErrorOr<EnvBuffers> step_buffers(const JaxConfig& c, const ffi::RemainingAr
     b.final_visual = t.ret<VisualState>(11, "final_visual", Elem::kByte, sizeof(VisualState));
     b.final_info = t.info(kFinalInfoRet, false);
     b.info = t.info(kInfoRet, false);
-    // The state is updated in place: XLA gives the aliased pairs one buffer (copying first where the input
-    // lives on, i.e. where it was not donated).
-    for (size_t i = 0; i < 4 + static_cast<size_t>(kInfoFieldCount) && t.error.empty(); ++i) {
+    // The state is updated in place. input_output_aliases asks XLA for one buffer per pair, and it mostly
+    // gives one; where it does not (seen on the GPU inside a scan), the result starts as a copy of the input.
+    for (size_t i = 0; i < kInPlacePairs && t.error.empty(); ++i) {
       const size_t a = i < 4 ? 1 + i : kFinalInfoArg + (i - 4), r = i < 4 ? i : kFinalInfoRet + (i - 4);
-      if (!aliased(args, rets, a, r))
-        t.error = "argument " + std::to_string(a) + " and result " + std::to_string(r) +
-                  " are not one buffer: call kage_step with its input_output_aliases";
+      if (std::optional<InPlaceCopy> copy = unaliased(args, rets, a, r, &t.error)) b.copies[b.copy_count++] = *copy;
     }
   }
   if (!t.error.empty()) return ffi::Unexpected(handler_error("kage_step", t.error));

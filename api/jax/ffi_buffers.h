@@ -14,6 +14,7 @@
 // every environment is independent, so [B, N] is one batch of B * N.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "api/jax/jax_config.h"
@@ -23,6 +24,17 @@
 #include "xla/ffi/api/ffi.h"
 
 namespace kage::jax {
+
+/// An in-place pair (a step argument and the result aliasing it) that XLA gave two buffers: the result must
+/// start as the argument, so the handler copies it over before the kernels run.
+struct InPlaceCopy {
+  void* to = nullptr;
+  const void* from = nullptr;
+  size_t bytes = 0;
+};
+
+/// The step's in-place pairs: the state (4) and the final_info columns.
+inline constexpr size_t kInPlacePairs = 4 + kInfoFieldCount;
 
 /// Environment rows of one call. The step-only members are null for a reset.
 struct EnvBuffers {
@@ -43,6 +55,8 @@ struct EnvBuffers {
   LatentState* final_latent = nullptr;
   uint8_t* final_segments = nullptr;
   VisualState* final_visual = nullptr;
+  InPlaceCopy copies[kInPlacePairs] = {};  ///< the first `copy_count` are needed (usually none)
+  size_t copy_count = 0;
 };
 
 /// The reset's buffers, or an error naming the one that does not fit the config.

@@ -78,6 +78,7 @@ KAGE_CU_FORWARD(cuMemsetD8, (CUdeviceptr p, unsigned char v, size_t n), (p, v, n
 KAGE_CU_FORWARD(cuMemsetD8Async, (CUdeviceptr p, unsigned char v, size_t n, CUstream s), (p, v, n, s))
 KAGE_CU_FORWARD(cuMemcpyHtoDAsync, (CUdeviceptr dst, const void* src, size_t bytes, CUstream s), (dst, src, bytes, s))
 KAGE_CU_FORWARD(cuMemcpyDtoHAsync, (void* dst, CUdeviceptr src, size_t bytes, CUstream s), (dst, src, bytes, s))
+KAGE_CU_FORWARD(cuMemcpyDtoDAsync, (CUdeviceptr dst, CUdeviceptr src, size_t bytes, CUstream s), (dst, src, bytes, s))
 KAGE_CU_FORWARD(cuMemcpy2DAsync, (const CUDA_MEMCPY2D* c, CUstream s), (c, s))
 KAGE_CU_FORWARD(cuMemHostAlloc, (void** p, size_t bytes, unsigned int flags), (p, bytes, flags))
 KAGE_CU_FORWARD(cuMemHostGetDevicePointer, (CUdeviceptr * d, void* p, unsigned int flags), (d, p, flags))
