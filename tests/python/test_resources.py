@@ -49,6 +49,21 @@ def test_make_vec_takes_a_shipped_name():
     assert env.config == str(REPO / "configs/throughput/simplest.yaml")
 
 
+def test_the_trainer_and_the_evaluator_take_shipped_names(tmp_path):
+    from kage.ppo import args as train_args
+    from kage.ppo import evaluate
+
+    args = train_args.parse_args(["--train-config-path", "kage_bench/bases/shape_black", "--eval-config-paths",
+                                  "kage_bench/background/1-eval", "throughput/simplest", "--device", "cpu"])
+    assert args.train_config_path == str(REPO / "configs/kage_bench/bases/shape_black.yaml")
+    assert args.eval_config_paths == [str(REPO / "configs/kage_bench/background/1-eval.yaml"),
+                                      str(REPO / "configs/throughput/simplest.yaml")]
+    with pytest.raises(SystemExit) as e:  # the evaluator's unknown name: near names, no traceback
+        evaluate.open_env("kage_bench/background/1-evl", 1, {}, "latest.pt", None)
+    assert "'kage_bench/background/1-evl' is neither a path nor a shipped config name" in str(e.value)
+    assert "near names: kage_bench/background/1-eval" in str(e.value)
+
+
 def test_the_nvrtc_wheel_is_searched_first(monkeypatch):
     wheel = importlib.metadata.distribution("nvidia-cuda-nvrtc")  # pinned in scripts/constraints.txt
     lib = [f for f in wheel.files if f.name == "libnvrtc.so.13"]

@@ -10,6 +10,7 @@ import os
 from dataclasses import dataclass, field
 from typing import List, Optional, Tuple
 
+from kage import resources
 from kage.ppo import plugins
 
 DESCRIPTION = ("PPO-CNN baseline of KAGE-Bench: train on one config, evaluate on it and on one or more others "
@@ -122,7 +123,7 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
             if problems:
                 parser.error(f"{pack}: run {args.out}: " + "; ".join(problems))
         return runs
-    args = Args(**namespace)
+    args = with_config_files(Args(**namespace))
     problems = validate(args)
     if problems:
         parser.error("; ".join(problems))
@@ -215,6 +216,23 @@ def eval_paths(args: Args) -> List[str]:
 def configs_of(args: Args) -> List[Tuple[str, str]]:
     """(label, path) of the configs a run evaluates on: "train" first, then the eval configs."""
     return [("train", args.train_config_path)] + list(zip(eval_labels(args), eval_paths(args)))
+
+
+def with_config_files(args: Args) -> Args:
+    """`args` with each shipped config's name (kage_bench/bases/shape_black) replaced by its installed file, so
+    that every later step, run.json included, sees one path."""
+    return dataclasses.replace(args, train_config_path=config_file(args.train_config_path),
+                               eval_config_path=args.eval_config_path and config_file(args.eval_config_path),
+                               eval_config_paths=[config_file(p) for p in args.eval_config_paths])
+
+
+def config_file(config: str) -> str:
+    """`config`'s file or folder, a shipped config's name resolved; kept as given when it is neither (the run
+    refuses it by name when it opens its configs)."""
+    try:
+        return resources.config_path(config)
+    except FileNotFoundError:
+        return config
 
 
 def eval_labels(args: Args) -> List[str]:

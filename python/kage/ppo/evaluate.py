@@ -22,6 +22,7 @@ from typing import List, Optional
 import torch
 
 import kage
+from kage import resources
 from kage.ppo import checkpoint, plugins, rundir, video
 from kage.errors import ConfigError
 from kage.util import tables
@@ -98,8 +99,10 @@ def spec_from_run_dir(file: str) -> dict:
 
 def open_env(config: str, num_envs: int, spec: dict, file: str, options) -> "kage.VecEnv":
     """A batch on `config`, refused where the policy of `file` does not fit its observations or actions."""
-    if not os.path.exists(config):
-        fail(f"config '{config}' not found")
+    try:
+        config = resources.config_path(config)
+    except FileNotFoundError as e:
+        fail(str(e))
     try:
         env = kage.make_vec(config, num_envs, device=options.device, asset_root=options.asset_root,
                             threads=options.threads)

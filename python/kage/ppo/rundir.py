@@ -251,7 +251,8 @@ def resolve_configs(configs: List[Tuple[str, str]], asset_root: Optional[str]) -
     specs = {}
     for label, config in configs:
         if not os.path.exists(config):
-            raise SystemExit(f"kage.ppo.train: config '{config}' ({label}) not found")
+            raise SystemExit(f"kage.ppo.train: config '{config}' ({label}) not found: give a YAML file, a kagec "
+                             "compile folder or a shipped config's name (kage_bench/bases/shape_black)")
         try:
             specs[label] = front_end.resolve(config, asset_root)
         except ConfigError as e:
