@@ -5,6 +5,7 @@ the GPU (take them with ``torch.from_dlpack``, ``jax.dlpack.from_dlpack`` or ``c
 stays allocated while it exists, but its contents are overwritten by the next ``reset`` or ``step``:
 copy what you keep (``obs.copy()``, ``tensor.clone()``).
 """
+import contextlib
 import os
 import threading
 from typing import Any, Dict, Optional, Sequence, Tuple, Union
@@ -102,8 +103,10 @@ class VecEnv:
     Threads: a batch may be used from any thread, and calls from several threads run one at a time, each
     one whole (a step's state is never torn, ``save_state`` never sees half a step). ``close()`` (and
     deleting or collecting the batch) waits for a call in progress on another thread; later calls raise
-    ``RuntimeError``. The outputs are one set of views for all threads: a thread that reads them while
-    another steps sees that step's values, so give a batch to one thread at a time, or copy what you keep.
+    ``RuntimeError``, as does a call made from inside another on the same thread (an actions object whose
+    ``__array__`` calls back into the batch). The outputs are one set of views for all threads: a thread
+    that reads them while another steps sees that step's values, so give a batch to one thread at a time,
+    or copy what you keep.
     On the GPU, closing waits for the device's queued work before the batch's memory is freed.
     """
 
@@ -114,6 +117,7 @@ class VecEnv:
     def __init__(self, handle: "kage._kage.Env", config: str, seed: int, asset_root: Optional[str] = None):
         self._handle = handle
         self._lock = threading.Lock()  # one call at a time (see Threads above)
+        self._caller: Optional[int] = None  # the thread inside a call, which a re-entrant call must not wait for
         self.config = config
         self._asset_root = asset_root
         self._spec: Optional[dict] = None
@@ -149,7 +153,7 @@ class VecEnv:
         the others keep their state). ``seed``: an int (each environment gets its own seed from it,
         see ``env_seeds``), ``num_envs`` ints (the environments' own seeds), or None (make_vec's seed
         on the first call, then a fresh draw from it on each later call)."""
-        with self._lock:
+        with self._one_call():
             return self._reset(seed, options)
 
     def _reset(self, seed: Seed, options: Optional[Dict[str, Any]]) -> Tuple[Any, Dict[str, Any]]:
@@ -174,7 +178,7 @@ class VecEnv:
     def step(self, actions) -> Tuple[Any, Any, Any, Any, Dict[str, Any]]:
         """One step of every environment; ``actions``: [num_envs] integers in 0..7 (numpy, torch,
         JAX, CuPy, ...; read in place on the GPU)."""
-        with self._lock:
+        with self._one_call():
             handle = self._live()
             _actions.submit(handle, actions)
             # The runtime reads device actions when its kernel runs: keep them alive until the next step.
@@ -184,7 +188,7 @@ class VecEnv:
     def outputs(self) -> Tuple[Any, Any, Any, Any, Dict[str, Any]]:
         """The arrays of the last reset or step, (obs, reward, terminated, truncated, info), without
         stepping: the same views every call, so a learner can take them once and read them each step."""
-        with self._lock:
+        with self._one_call():
             self._live()
             return self._obs, self._reward, self._terminated, self._truncated, self._info_dict()
 
@@ -192,7 +196,7 @@ class VecEnv:
         """Releases the environments. Arrays and tensors still viewing their outputs keep that memory
         alive until they are dropped. Closing twice is harmless; any other use raises. Waits for a call
         in progress on another thread."""
-        with self._lock:
+        with self._one_call():
             if self._handle is not None:
                 self._handle.close()
             self._handle = None
@@ -211,21 +215,21 @@ class VecEnv:
         """The whole batch's state and last outputs (about 1.4 KB per environment); waits for queued
         work. ``load_state`` on a batch of the same config and size, on either device, continues
         exactly as this one would."""
-        with self._lock:
+        with self._one_call():
             return self._live().save_state()
 
     def load_state(self, state: bytes) -> Tuple[Any, Dict[str, Any]]:
         """Restores ``save_state``'s bytes and returns the restored (obs, info). ``state``: bytes or any
         bytes-like object (bytearray, memoryview, a uint8 numpy array; strided or read-only is fine)."""
         data = _state_bytes(state)
-        with self._lock:
+        with self._one_call():
             self._live().load_state(data)
             return self._obs, self._info_dict()
 
     def synchronize(self) -> None:
         """Waits for the batch's queued GPU work; raises ValueError if an earlier step had an
         out-of-range device action."""
-        with self._lock:
+        with self._one_call():
             self._live().synchronize()
 
     @property
@@ -262,6 +266,20 @@ class VecEnv:
         state = "closed" if self.closed else f"{self.num_envs} envs on {self.device}"
         return f"<kage.VecEnv {self.config!r}, {state}, spec {self.spec_hash[:12]}>"
 
+    @contextlib.contextmanager
+    def _one_call(self):
+        """Holds the batch for one call. A call made from inside another on the same thread (an actions
+        object whose __array__ or __dlpack__ calls back into the batch) would wait for itself forever: it raises."""
+        if self._caller == threading.get_ident():
+            raise RuntimeError("a call into this environment from inside another of its calls on the same thread "
+                               "(an actions object calling back into the batch while it is read): call it afterwards")
+        with self._lock:
+            self._caller = threading.get_ident()
+            try:
+                yield
+            finally:
+                self._caller = None
+
     def _live(self) -> "kage._kage.Env":
         if self._handle is None:
             raise RuntimeError("this environment is closed: make a new one with kage.make_vec")
@@ -296,6 +314,10 @@ def make_vec(config: Union[str, os.PathLike], num_envs: int, device: str = "cpu"
     if not _is_integer(num_envs) or not 0 < num_envs <= MAX_INT32:
         raise ValueError(f"num_envs={num_envs!r}: a positive integer up to {MAX_INT32}")
     seed = _seed_value(seed)
+    if asset_root is not None:
+        if not isinstance(asset_root, (str, bytes, os.PathLike)):
+            raise ValueError(f"asset_root={asset_root!r:.80}: a directory path (str or os.PathLike)")
+        asset_root = os.fsdecode(asset_root)
     config = resources.config_path(config)  # a path, or a shipped config's name; FileNotFoundError names near ones
     if threads is None:
         threads = min(int(num_envs), os.cpu_count() or 1)

@@ -81,8 +81,10 @@ def test_a_loaded_state_counts_as_a_reset():
     ({"num_envs": 2, "threads": 2**31}, "threads"),
     ({"num_envs": 2, "threads": 1.5}, "threads"),
     ({"num_envs": 2.0}, "num_envs"),
+    ({"num_envs": 2, "asset_root": 3}, "asset_root"),
+    ({"num_envs": 2, "asset_root": ["assets"]}, "asset_root"),
 ])
-def test_sizes_beyond_the_bindings_integers_are_value_errors(kwargs, match):
+def test_arguments_the_binding_cannot_take_are_value_errors(kwargs, match):
     with pytest.raises(ValueError, match=match):
         kage.make_vec(SIMPLEST, **kwargs)
 

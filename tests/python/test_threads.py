@@ -187,3 +187,37 @@ def test_reset_and_step_from_two_threads_return_whole_outputs():
             assert obs is not None and info["timestep"].shape == (32,)
         worker.join()
         assert not errors, errors
+
+
+def test_a_call_from_inside_a_call_on_the_same_thread_raises_instead_of_hanging():
+    # An actions object whose __array__ calls back into the batch runs while step() holds it: waiting for
+    # itself, the thread would hang forever.
+    result = run_child("""
+        outcomes = {}
+        for name in ("close", "step", "reset", "save_state"):
+            env = kage.make_vec(SIMPLEST, 2, threads=1)
+            env.reset(seed=0)
+
+            class CallsBack:
+                def __array__(self, dtype=None, copy=None):
+                    getattr(env, name)(*([np.zeros(2, dtype=np.int64)] if name == "step" else []))
+                    return np.array([2, 2])
+
+            def stepper():
+                try:
+                    env.step(CallsBack())
+                    outcomes[name] = "stepped"
+                except RuntimeError as e:
+                    outcomes[name] = str(e)
+
+            worker = threading.Thread(target=stepper, daemon=True)
+            worker.start()
+            worker.join(timeout=30)
+            assert not worker.is_alive(), f"{name} from inside step hangs"
+            assert "from inside another" in outcomes[name], outcomes
+            assert not env.closed
+            env.step(np.array([2, 2]))  # the batch is still usable
+        print("ok")
+        """)
+    assert result.returncode == 0, f"exit {result.returncode}: {result.stderr[-2000:]}"
+    assert result.stdout.strip() == "ok"
