@@ -1,7 +1,7 @@
 """kage.ppo.fast.triton_conv's packed convolutions (Triton implicit-GEMM kernels, the run as a grid axis) against
-cuDNN's grouped convolutions, forward and the input, weight and bias gradients, for the NatureCNN's three layers at
-K = 3 and 8 packed runs, in fp32 and bf16. The fp32 checks allow 1e-3: tl.dot rounds fp32 operands to TF32 (10-bit
-mantissa). The bf16 checks allow 2e-2 (outputs rounded to bf16). Errors are max |got - want| / max |want|.
+cuDNN's grouped convolutions, forward and the input, weight and bias gradients, for the NatureCNN's three layers
+(alone and with the fused ReLU) at K = 3 and 8 packed runs, in fp32 and bf16. The fp32 checks allow 1e-3: tl.dot
+rounds fp32 operands to TF32 (10-bit mantissa). The bf16 checks allow 2e-2 (outputs rounded to bf16). Errors are max |got - want| / max |want|.
 `python3 tests/gpu/test_triton_conv.py [--profile]` also times the torso against cuDNN channels-last bf16."""
 import argparse
 import pathlib
@@ -23,15 +23,16 @@ def relative_error(got: torch.Tensor, want: torch.Tensor) -> float:
     return ((got.float() - want).abs().max() / want.abs().max().clamp_min(1e-30)).item()
 
 
-def check_layer(k: int, b: int, layer, dtype: torch.dtype, tolerance: float) -> int:
-    """packed_conv's output and gradients (x, weight, bias) for one layer against F.conv2d(groups=K) in fp32 on
-    the same (dtype-rounded) values; prints one line per quantity and returns the number of failures."""
+def check_layer(k: int, b: int, layer, dtype: torch.dtype, tolerance: float, relu: bool = False) -> int:
+    """packed_conv's output and gradients (x, weight, bias) for one layer (with its fused ReLU under `relu`)
+    against F.conv2d(groups=K) (and F.relu) in fp32 on the same (dtype-rounded) values; prints one line per
+    quantity and returns the number of failures."""
     name, side, cin, cout, ksize, stride = layer
     torch.manual_seed(0)
     x = torch.randn(k, b, side, side, cin, device="cuda").to(dtype).requires_grad_()
     conv = torch.nn.Conv2d(k * cin, k * cout, ksize, stride, groups=k, device="cuda")
     weight, bias = conv.weight.detach().requires_grad_(), conv.bias.detach().uniform_(-1, 1).requires_grad_()
-    y = tc.packed_conv(x, weight, bias, stride)
+    y = tc.packed_conv(x, weight, bias, stride, relu=relu)
     dy = torch.randn_like(y)
     got = (y,) + torch.autograd.grad(y, (x, weight, bias), dy)
 
@@ -39,6 +40,8 @@ def check_layer(k: int, b: int, layer, dtype: torch.dtype, tolerance: float) -> 
     w_ref = weight.detach().to(dtype).float().requires_grad_()
     b_ref = bias.detach().clone().requires_grad_()
     y_ref = F.conv2d(x_ref, w_ref, b_ref, stride=stride, groups=k)
+    if relu:
+        y_ref = F.relu(y_ref)
     out = y_ref.shape[-1]
     dy_ref = dy.float().permute(1, 0, 4, 2, 3).reshape(b, k * cout, out, out)
     dx_ref, dw_ref, db_ref = torch.autograd.grad(y_ref, (x_ref, w_ref, b_ref), dy_ref)
@@ -50,7 +53,7 @@ def check_layer(k: int, b: int, layer, dtype: torch.dtype, tolerance: float) -> 
         error = relative_error(g, r)
         ok = error <= tolerance and g.dtype == (dtype if quantity in ("y", "dx") else torch.float32)
         failures += not ok
-        print(f"K = {k}, B = {b}, {str(dtype)[6:]}, {name} {quantity}: max relative error {error:.2e} "
+        print(f"K = {k}, B = {b}, {str(dtype)[6:]}, {name}{' + ReLU' if relu else ''} {quantity}: max relative error {error:.2e} "
               f"(tolerance {tolerance:.0e}, {str(g.dtype)[6:]}) {'PASS' if ok else 'FAIL'}", flush=True)
     return failures
 
@@ -69,9 +72,9 @@ def torso_steps(k: int, b: int):
 
     def triton_step():
         with torch.autocast("cuda", dtype=torch.bfloat16):
-            x = F.relu(tc.packed_conv(frames, s2d.weight_space_to_depth(convs[0].weight, 4), convs[0].bias))
-            x = F.relu(tc.packed_conv(x, convs[1].weight, convs[1].bias, 2))
-            x = F.relu(tc.packed_conv(x, convs[2].weight, convs[2].bias))
+            x = tc.packed_conv(frames, s2d.weight_space_to_depth(convs[0].weight, 4), convs[0].bias, relu=True)
+            x = tc.packed_conv(x, convs[1].weight, convs[1].bias, 2, relu=True)
+            x = tc.packed_conv(x, convs[2].weight, convs[2].bias, relu=True)
             loss = x.sum()
         for c in convs:
             c.zero_grad(set_to_none=True)
@@ -116,12 +119,13 @@ def full_fp32_references() -> None:
     torch.backends.cuda.matmul.allow_tf32 = False
 
 
+@pytest.mark.parametrize("relu", [False, True], ids=["conv", "conv_relu"])
 @pytest.mark.parametrize("k, b", [(3, 64), (8, 2048)])
 @pytest.mark.parametrize("dtype, tolerance", [(torch.float32, 1e-3), (torch.bfloat16, 2e-2)])
 @pytest.mark.parametrize("layer", LAYERS, ids=[layer[0] for layer in LAYERS])
-def test_packed_conv_equals_grouped_conv(k, b, dtype, tolerance, layer):
+def test_packed_conv_equals_grouped_conv(k, b, dtype, tolerance, layer, relu):
     full_fp32_references()
-    assert check_layer(k, b, layer, dtype, tolerance) == 0
+    assert check_layer(k, b, layer, dtype, tolerance, relu) == 0
     torch.cuda.empty_cache()
 
 
@@ -138,8 +142,9 @@ def main() -> None:
     for k, b in ((3, 64), (8, 2048)):
         for dtype, tolerance in ((torch.float32, 1e-3), (torch.bfloat16, 2e-2)):
             for layer in LAYERS:
-                failures += check_layer(k, b, layer, dtype, tolerance)
-                torch.cuda.empty_cache()
+                for relu in (False, True):
+                    failures += check_layer(k, b, layer, dtype, tolerance, relu)
+                    torch.cuda.empty_cache()
 
     k, b = 8, 2048
     triton_step, cudnn_step = torso_steps(k, b)
@@ -148,11 +153,11 @@ def main() -> None:
           f"triton {triton_ms:.2f} ms ({torso_flop(b, k) / triton_ms / 1e9:.0f} TFLOP/s), "
           f"cuDNN channels-last {cudnn_ms:.2f} ms ({torso_flop(b, k) / cudnn_ms / 1e9:.0f} TFLOP/s), "
           f"cuDNN / triton {cudnn_ms / triton_ms:.2f}")
-    print(f"autotuned configs at K = {k}, B = {b}, bf16 (key: B, H, W, Cin, Cout, kh, kw, dtypes):")
+    print(f"autotuned configs at K = {k}, B = {b}, bf16 (key: B, H, W, Cin, Cout, kh, kw, ReLU, dtypes):")
     for name, kernel in (("forward", tc.forward_kernel), ("dgrad", tc.dgrad_kernel), ("wgrad", tc.wgrad_kernel)):
         for key, config in getattr(kernel, "cache", {}).items():
             if key[0] == b and "bfloat16" in str(key):
-                print(f"  {name} {key[1:7]}: {config}")
+                print(f"  {name} {key[1:8]}: {config}")
     if a.profile:
         print_profile("triton", triton_step)
         print_profile("cuDNN channels-last", cudnn_step)

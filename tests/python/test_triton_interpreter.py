@@ -1,9 +1,9 @@
 """kage.ppo.fast.triton_conv's kernels (--triton-conv) on the CPU under Triton's interpreter, in float32, against
 torch's grouped convolutions (F.conv2d(groups=K), the plain layers) on the same values: the output and the input,
 weight and bias gradients of the NatureCNN's three layers as the trainer runs them (conv1 as the 2x2 stride-1
-convolution of 4x4 blocks, 48 channels; conv2 as the 2x2 one of 2x2 blocks, 128 channels; conv3 3x3), under each
-autotuning config of every kernel, K = 2 runs of B = 2 or 3 frames; the weight gradient's split into partial
-sums; and the Agent's --triton-conv torso against its plain one, forward and parameter gradients.
+convolution of 4x4 blocks, 48 channels; conv2 as the 2x2 one of 2x2 blocks, 128 channels; conv3 3x3), alone and
+with the fused ReLU, under each autotuning config of every kernel, K = 2 runs of B = 2 or 3 frames; the weight
+and bias gradients' split into partial sums; and the Agent's --triton-conv torso against its plain one, forward and parameter gradients.
 
 The interpreter computes tl.dot in full float32 (no TF32), so the kernels must agree with torch to float32
 rounding. bfloat16 is checked on the GPU only (tests/gpu/test_triton_conv.py): the interpreter does not emulate
@@ -40,13 +40,11 @@ def interpreted():
                     "its own pytest process (as CTest does)")
 
 
-@pytest.fixture(params=range(4), ids=lambda i: f"config{i}")
-def one_config(request, monkeypatch):
-    """Each kernel restricted to its request.param-th autotuning config: with one config the autotuner runs it
-    without benchmarking (which needs a GPU driver), and each config's tile sizes meet the masks differently."""
+def use_config(index: int, monkeypatch) -> None:
+    """Each kernel restricted to its index-th autotuning config: with one config the autotuner runs it without
+    benchmarking (which needs a GPU driver), and each config's tile sizes meet the masks differently."""
     for kernel in KERNELS:
-        monkeypatch.setattr(kernel, "configs", [kernel.configs[request.param]])
-    return request.param
+        monkeypatch.setattr(kernel, "configs", [kernel.configs[index]])
 
 
 def relative_error(got: torch.Tensor, want: torch.Tensor) -> float:
@@ -54,12 +52,13 @@ def relative_error(got: torch.Tensor, want: torch.Tensor) -> float:
     return ((got.double() - want.double()).abs().max() / want.double().abs().max()).item()
 
 
-def packed_layer(name: str, x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int) -> torch.Tensor:
+def packed_layer(name: str, x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int,
+                 relu: bool) -> torch.Tensor:
     """One layer as Agent._torso_triton runs it: conv1 on the frames' 4x4 blocks, conv2 through packed_conv's
-    2x2 blocks, conv3 as it is."""
+    2x2 blocks, conv3 as it is; the ReLU fused in under `relu`."""
     if name == "conv1":
-        return tc.packed_conv(space_to_depth(x, 4), weight_space_to_depth(weight, 4), bias)
-    return tc.packed_conv(x, weight, bias, stride)
+        return tc.packed_conv(space_to_depth(x, 4), weight_space_to_depth(weight, 4), bias, relu=relu)
+    return tc.packed_conv(x, weight, bias, stride, relu=relu)
 
 
 def grouped_layer(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int) -> torch.Tensor:
@@ -70,21 +69,29 @@ def grouped_layer(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, str
     return y.reshape(b, k, -1, *y.shape[2:]).permute(1, 0, 3, 4, 2)
 
 
+# The trainer's fused ReLU under every config; the plain convolution under the first (the same kernels with the
+# ReLU's code compiled out), to keep the interpreter's time down.
+@pytest.mark.parametrize("config, relu", [(0, False), (0, True), (1, True), (2, True), (3, True)],
+                         ids=["config0", "config0_relu", "config1_relu", "config2_relu", "config3_relu"])
 @pytest.mark.parametrize("layer", LAYERS, ids=[layer[0] for layer in LAYERS])
-def test_layer_equals_grouped_conv(layer, one_config):
+def test_layer_equals_grouped_conv(layer, config, relu, monkeypatch):
+    use_config(config, monkeypatch)
     name, side, cin, cout, ksize, stride = layer
     # K != B once: an index that mixes the two up reads other frames (the formulas are the same under every
     # config); B = 2 under the others, to keep the interpreter's time down.
-    k, b = 2, 3 if one_config == 0 else 2
-    generator = torch.Generator().manual_seed(one_config)
+    k, b = 2, 3 if config == 0 else 2
+    generator = torch.Generator().manual_seed(config)
     x = torch.randn(k, b, side, side, cin, generator=generator, requires_grad=True)
     weight = torch.randn(k * cout, cin, ksize, ksize, generator=generator, requires_grad=True)
     bias = torch.randn(k * cout, generator=generator, requires_grad=True)
 
-    y = packed_layer(name, x, weight, bias, stride)
+    y = packed_layer(name, x, weight, bias, stride, relu)
     dy = torch.randn(y.shape, generator=generator)
     got = (y,) + torch.autograd.grad(y, (x, weight, bias), dy)
     y_ref = grouped_layer(x, weight, bias, stride)
+    if relu:
+        y_ref = F.relu(y_ref)
+        assert 0.2 < (y_ref > 0).double().mean() < 0.8, "both sides of the ReLU are exercised"
     want = (y_ref,) + torch.autograd.grad(y_ref, (x, weight, bias), dy)
 
     for quantity, g, w in zip(("y", "dx", "dw", "db"), got, want):
@@ -96,7 +103,8 @@ def test_layer_equals_grouped_conv(layer, one_config):
 def test_weight_gradient_partial_sums(chunk, monkeypatch):
     """On the GPU, M's rows split into parts of at least 2,048 rows; here conv3's 288 rows of K = 2 runs of
     B = 2 split into 3 parts, the last one short (and a chunk that is no multiple of BLOCK_M: rows masked
-    within a part), and the parts' sums must add up to the whole gradient."""
+    within a part), and the parts' sums must add up to the whole weight and bias gradients, with the ReLU's
+    gradient applied."""
     monkeypatch.setattr(tc, "_wgrad_chunk", lambda m, runs: chunk)
     for kernel in KERNELS:
         monkeypatch.setattr(kernel, "configs", kernel.configs[:1])
@@ -104,12 +112,14 @@ def test_weight_gradient_partial_sums(chunk, monkeypatch):
     generator = torch.Generator().manual_seed(chunk)
     x = torch.randn(k, b, side, side, cin, generator=generator)
     weight = torch.randn(k * cout, cin, ksize, ksize, generator=generator, requires_grad=True)
-    out = side - ksize + 1
-    dy = torch.randn(k, b, out, out, cout, generator=generator)
-    (dw_ref,) = torch.autograd.grad(grouped_layer(x, weight, None, 1), weight, dy)
+    bias = torch.randn(k * cout, generator=generator, requires_grad=True)
+    y = F.relu(grouped_layer(x, weight, bias, 1))
+    dy = torch.randn(y.shape, generator=generator)
+    dw_ref, db_ref = torch.autograd.grad(y, (weight, bias), dy)
 
-    dw = tc._wgrad(x, dy, ksize, ksize)  # [K, kh, kw, Cin, Cout]
+    dw, db = tc._wgrad(x, dy, y.detach().contiguous(), ksize, ksize, relu=True)  # [K, kh, kw, Cin, Cout], [K, Cout]
     assert relative_error(dw, dw_ref.reshape(k, cout, cin, ksize, ksize).permute(0, 3, 4, 2, 1)) <= TOLERANCE
+    assert relative_error(db, db_ref.reshape(k, cout)) <= TOLERANCE
 
 
 def test_agent_triton_torso_equals_plain(monkeypatch):

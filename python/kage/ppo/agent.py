@@ -124,9 +124,9 @@ class Agent(nn.Module):
         from kage.ppo.fast import triton_conv  # here, not at the top: triton is needed only under the flag
         k, b = obs.shape[:2]
         x = space_to_depth(obs, 4, self.input_dtype).div_(255.0)
-        x = F.relu(triton_conv.packed_conv(x, weight_space_to_depth(self.conv1.weight, 4), self.conv1.bias))
-        x = F.relu(triton_conv.packed_conv(x, self.conv2.weight, self.conv2.bias, stride=2))
-        x = F.relu(triton_conv.packed_conv(x, self.conv3.weight, self.conv3.bias))
+        x = triton_conv.packed_conv(x, weight_space_to_depth(self.conv1.weight, 4), self.conv1.bias, relu=True)
+        x = triton_conv.packed_conv(x, self.conv2.weight, self.conv2.bias, stride=2, relu=True)
+        x = triton_conv.packed_conv(x, self.conv3.weight, self.conv3.bias, relu=True)
         return x.permute(0, 1, 4, 2, 3).reshape(k, b, self.flat)
 
     def run_view(self, tensor: torch.Tensor) -> torch.Tensor:

@@ -7,6 +7,8 @@ same. Imported only under --triton-conv: triton is a GPU-machine dependency (and
 timed on the GPU by tests/gpu/test_triton_conv.py, and in float32 on the CPU under Triton's interpreter by
 tests/python/test_triton_interpreter.py.
 """
+from typing import Tuple
+
 import torch
 import triton
 import triton.language as tl
@@ -22,18 +24,19 @@ _DGRAD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_N": n, "BLOCK_K": k}, num_
                                         (128, 64, 64, 8, 3))]
 _WGRAD_CONFIGS = [triton.Config({"BLOCK_D": d, "BLOCK_M": m}, num_warps=w, num_stages=s)
                   for d, m, w, s in ((64, 64, 4, 3), (128, 64, 4, 3), (64, 128, 4, 4), (128, 128, 8, 3))]
-_SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW"]
+_SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "RELU"]
 
 
 @triton.autotune(configs=_FORWARD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
 def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
                    H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
-                   CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                   CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr, RELU: tl.constexpr,
                    BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
     """y[run, m, co] = bias + sum over (kh, kw, ci) of x[run, b, oh + kh, ow + kw, ci] * w[run, kh, kw, ci, co],
-    m = (b, oh, ow). For one kh the (kw, ci) pairs are KW * CIN contiguous input elements (NHWC), so the
-    reduction walks kh and BLOCK_K-wide pieces of that span: contiguous, coalesced loads."""
+    m = (b, oh, ow), then max(y, 0) under RELU. For one kh the (kw, ci) pairs are KW * CIN contiguous input
+    elements (NHWC), so the reduction walks kh and BLOCK_K-wide pieces of that span: contiguous, coalesced
+    loads."""
     STEPS: tl.constexpr = (KW * CIN + BLOCK_K - 1) // BLOCK_K
     run = tl.program_id(2).to(tl.int64)
     rows = tl.program_id(0) * BLOCK_M + tl.arange(0, BLOCK_M)
@@ -57,6 +60,8 @@ def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
                          mask=span_ok[:, None] & col_ok[None, :], other=0.0)
         acc += tl.dot(patch, weight)
     acc += tl.load(bias_ptr + run * COUT + cols, mask=col_ok, other=0.0)[None, :]
+    if RELU:
+        acc = tl.maximum(acc, 0.0)
     y_run = y_ptr + (run * B) * (OH * OW * COUT)
     tl.store(y_run + (rows.to(tl.int64)[:, None] * COUT + cols[None, :]), acc.to(y_ptr.dtype.element_ty),
              mask=row_ok[:, None] & col_ok[None, :])
@@ -64,12 +69,14 @@ def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
 
 @triton.autotune(configs=_DGRAD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
-def dgrad_kernel(dy_ptr, w_ptr, dx_ptr, B,
+def dgrad_kernel(dy_ptr, y_ptr, w_ptr, dx_ptr, B,
                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
-                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr, RELU: tl.constexpr,
                  BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
     """Stride 1: dx[run, b, ih, iw, ci] = sum over (kh, kw, co) of dy[run, b, ih - kh, iw - kw, co] *
-    w[run, kh, kw, ci, co], the taps whose output position falls outside OH x OW masked off."""
+    w[run, kh, kw, ci, co], the taps whose output position falls outside OH x OW masked off. Under RELU, dy is
+    the gradient after the layer's ReLU: each element counts where the output y there is positive (ReLU's
+    gradient, read where dy is read instead of in a pass of its own)."""
     STEPS: tl.constexpr = (COUT + BLOCK_K - 1) // BLOCK_K
     run = tl.program_id(2).to(tl.int64)
     rows = tl.program_id(0) * BLOCK_M + tl.arange(0, BLOCK_M)
@@ -83,6 +90,7 @@ def dgrad_kernel(dy_ptr, w_ptr, dx_ptr, B,
     # positions before it, wherever the mask allows.
     dy_row = ((b * OH + ih) * OW + iw).to(tl.int64) * COUT
     dy_run = dy_ptr + (run * B) * (OH * OW * COUT)
+    y_run = y_ptr + (run * B) * (OH * OW * COUT)
     w_run = w_ptr + run * (KH * KW * CIN * COUT)
     acc = tl.zeros((BLOCK_M, BLOCK_N), dtype=tl.float32)
     for step in range(0, KH * KW * STEPS):
@@ -92,8 +100,11 @@ def dgrad_kernel(dy_ptr, w_ptr, dx_ptr, B,
         chans = step % STEPS * BLOCK_K + tl.arange(0, BLOCK_K)
         chan_ok = chans < COUT
         tap_ok = row_ok & (ih >= kh) & (ih - kh < OH) & (iw >= kw) & (iw - kw < OW)
-        grad = tl.load(dy_run + (dy_row[:, None] + (chans - (kh * OW + kw) * COUT)[None, :]),
-                       mask=tap_ok[:, None] & chan_ok[None, :], other=0.0)
+        at = dy_row[:, None] + (chans - (kh * OW + kw) * COUT)[None, :]
+        grad = tl.load(dy_run + at, mask=tap_ok[:, None] & chan_ok[None, :], other=0.0)
+        if RELU:
+            positive = tl.load(y_run + at, mask=tap_ok[:, None] & chan_ok[None, :], other=0.0) > 0
+            grad = tl.where(positive, grad, tl.zeros_like(grad))
         weight = tl.load(w_run + ((tap * CIN + cols)[None, :] * COUT + chans[:, None]),
                          mask=chan_ok[:, None] & col_ok[None, :], other=0.0)
         acc += tl.dot(grad, weight)
@@ -104,14 +115,16 @@ def dgrad_kernel(dy_ptr, w_ptr, dx_ptr, B,
 
 @triton.autotune(configs=_WGRAD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
-def wgrad_kernel(x_ptr, dy_ptr, parts_ptr, B, CHUNK, SPLIT,
+def wgrad_kernel(x_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLIT,
                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
-                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr, RELU: tl.constexpr,
                  BLOCK_D: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_M: tl.constexpr):
     """parts[run, part, kh, kw, ci, co] = sum over m in the part's CHUNK rows of x[run, b, oh + kh, ow + kw, ci]
-    * dy[run, m, co]. A program owns BLOCK_D contiguous (kw, ci) pairs of one kh (axis 0), BLOCK_N output
-    channels (axis 1) and one (run, part) (axis 2): SPLIT parts per run spread M's up to 2 M rows over the GPU,
-    each writing fp32 partial sums that the caller adds up."""
+    * dy[run, m, co], and bias_parts[run, part, co] = the sum of those dy[run, m, co]. A program owns BLOCK_D
+    contiguous (kw, ci) pairs of one kh (axis 0), BLOCK_N output channels (axis 1) and one (run, part) (axis 2):
+    SPLIT parts per run spread M's up to 2 M rows over the GPU, each writing fp32 partial sums that the caller
+    adds up; the programs of the first (kh, kw, ci) block also sum dy for the bias, on the tiles they load
+    anyway. Under RELU, dy counts where the output y is positive (as in dgrad_kernel)."""
     STEPS: tl.constexpr = (KW * CIN + BLOCK_D - 1) // BLOCK_D
     kh = tl.program_id(0) // STEPS
     span = tl.program_id(0) % STEPS * BLOCK_D + tl.arange(0, BLOCK_D)
@@ -125,7 +138,10 @@ def wgrad_kernel(x_ptr, dy_ptr, parts_ptr, B, CHUNK, SPLIT,
     end = tl.minimum(start + CHUNK, m_total)
     x_run = x_ptr + (run * B) * (H * W * CIN) + kh * (W * CIN)
     dy_run = dy_ptr + (run * B) * (OH * OW * COUT)
+    y_run = y_ptr + (run * B) * (OH * OW * COUT)
+    sums_bias = tl.program_id(0) == 0
     acc = tl.zeros((BLOCK_D, BLOCK_N), dtype=tl.float32)
+    bias_acc = tl.zeros((BLOCK_N,), dtype=tl.float32)
     for m0 in range(start, end, BLOCK_M):
         rows = m0 + tl.arange(0, BLOCK_M)
         row_ok = rows < end
@@ -135,12 +151,19 @@ def wgrad_kernel(x_ptr, dy_ptr, parts_ptr, B, CHUNK, SPLIT,
         x_row = ((b * H + oh) * W + ow).to(tl.int64) * CIN
         patch = tl.load(x_run + (x_row[:, None] + span[None, :]), mask=row_ok[:, None] & span_ok[None, :],
                         other=0.0)
-        grad = tl.load(dy_run + (rows.to(tl.int64)[:, None] * COUT + cols[None, :]),
-                       mask=row_ok[:, None] & col_ok[None, :], other=0.0)
+        at = rows.to(tl.int64)[:, None] * COUT + cols[None, :]
+        grad = tl.load(dy_run + at, mask=row_ok[:, None] & col_ok[None, :], other=0.0)
+        if RELU:
+            positive = tl.load(y_run + at, mask=row_ok[:, None] & col_ok[None, :], other=0.0) > 0
+            grad = tl.where(positive, grad, tl.zeros_like(grad))
         acc += tl.dot(tl.trans(patch), grad)
+        if sums_bias:
+            bias_acc += tl.sum(grad.to(tl.float32), axis=0)
     parts_run = parts_ptr + tl.program_id(2).to(tl.int64) * (KH * KW * CIN * COUT)
     tl.store(parts_run + ((kh * (KW * CIN) + span)[:, None] * COUT + cols[None, :]), acc,
              mask=span_ok[:, None] & col_ok[None, :])
+    if sums_bias:
+        tl.store(bias_parts_ptr + tl.program_id(2).to(tl.int64) * COUT + cols, bias_acc, mask=col_ok)
 
 
 def _width_block(channels: int) -> int:
@@ -154,15 +177,16 @@ def _wgrad_chunk(m: int, runs: int) -> int:
     return max(2048, triton.cdiv(triton.cdiv(m, max(1, 512 // runs)), 128) * 128)
 
 
-def _shape_args(h: int, w: int, kh: int, kw: int, cin: int, cout: int) -> dict:
-    return dict(H=h, W=w, OH=h - kh + 1, OW=w - kw + 1, CIN=cin, COUT=cout, KH=kh, KW=kw)
+def _shape_args(h: int, w: int, kh: int, kw: int, cin: int, cout: int, relu: bool) -> dict:
+    return dict(H=h, W=w, OH=h - kh + 1, OW=w - kw + 1, CIN=cin, COUT=cout, KH=kh, KW=kw, RELU=relu)
 
 
-def _forward(x: torch.Tensor, w: torch.Tensor, bias: torch.Tensor) -> torch.Tensor:
-    """x [K, B, H, W, Cin], w [K, kh, kw, Cin, Cout] (x's dtype), bias [K * Cout] fp32 -> [K, B, OH, OW, Cout]."""
+def _forward(x: torch.Tensor, w: torch.Tensor, bias: torch.Tensor, relu: bool) -> torch.Tensor:
+    """x [K, B, H, W, Cin], w [K, kh, kw, Cin, Cout] (x's dtype), bias [K * Cout] fp32 -> [K, B, OH, OW, Cout]
+    (through a ReLU under `relu`)."""
     k, b, h, wd, cin = x.shape
     _, kh, kw, _, cout = w.shape
-    shape = _shape_args(h, wd, kh, kw, cin, cout)
+    shape = _shape_args(h, wd, kh, kw, cin, cout, relu)
     y = torch.empty((k, b, shape["OH"], shape["OW"], cout), device=x.device, dtype=x.dtype)
     block_n = _width_block(cout)
     grid = lambda meta: (triton.cdiv(b * shape["OH"] * shape["OW"], meta["BLOCK_M"]), triton.cdiv(cout, block_n), k)
@@ -170,66 +194,75 @@ def _forward(x: torch.Tensor, w: torch.Tensor, bias: torch.Tensor) -> torch.Tens
     return y
 
 
-def _dgrad(dy: torch.Tensor, w: torch.Tensor, h: int, wd: int) -> torch.Tensor:
-    """dy [K, B, OH, OW, Cout], w [K, kh, kw, Cin, Cout] (dy's dtype) -> dx [K, B, H, W, Cin]."""
+def _dgrad(dy: torch.Tensor, y: torch.Tensor, w: torch.Tensor, h: int, wd: int, relu: bool) -> torch.Tensor:
+    """dy and the output y [K, B, OH, OW, Cout], w [K, kh, kw, Cin, Cout] (dy's dtype) -> dx [K, B, H, W, Cin];
+    under `relu`, dy is taken where y > 0 only."""
     k, b, _, _, cout = dy.shape
     _, kh, kw, cin, _ = w.shape
     dx = torch.empty((k, b, h, wd, cin), device=dy.device, dtype=dy.dtype)
     grid = lambda meta: (triton.cdiv(b * h * wd, meta["BLOCK_M"]), triton.cdiv(cin, meta["BLOCK_N"]), k)
-    dgrad_kernel[grid](dy, w, dx, b, **_shape_args(h, wd, kh, kw, cin, cout))
+    dgrad_kernel[grid](dy, y, w, dx, b, **_shape_args(h, wd, kh, kw, cin, cout, relu))
     return dx
 
 
-def _wgrad(x: torch.Tensor, dy: torch.Tensor, kh: int, kw: int) -> torch.Tensor:
-    """x [K, B, H, W, Cin], dy [K, B, OH, OW, Cout] (same dtype) -> dw [K, kh, kw, Cin, Cout] in fp32."""
+def _wgrad(x: torch.Tensor, dy: torch.Tensor, y: torch.Tensor, kh: int, kw: int,
+           relu: bool) -> Tuple[torch.Tensor, torch.Tensor]:
+    """x [K, B, H, W, Cin], dy and the output y [K, B, OH, OW, Cout] (same dtype) -> dw [K, kh, kw, Cin, Cout]
+    and db [K, Cout] in fp32; under `relu`, dy is taken where y > 0 only."""
     k, b, h, wd, cin = x.shape
     _, _, oh, ow, cout = dy.shape
     chunk = _wgrad_chunk(b * oh * ow, k)
     split = triton.cdiv(b * oh * ow, chunk)
     parts = torch.empty((k, split, kh, kw, cin, cout), device=x.device, dtype=torch.float32)
+    bias_parts = torch.empty((k, split, cout), device=x.device, dtype=torch.float32)
     block_n = _width_block(cout)
     grid = lambda meta: (kh * triton.cdiv(kw * cin, meta["BLOCK_D"]), triton.cdiv(cout, block_n), k * split)
-    wgrad_kernel[grid](x, dy, parts, b, chunk, split, **_shape_args(h, wd, kh, kw, cin, cout), BLOCK_N=block_n)
-    return parts.sum(dim=1)
+    wgrad_kernel[grid](x, dy, y, parts, bias_parts, b, chunk, split, **_shape_args(h, wd, kh, kw, cin, cout, relu),
+                       BLOCK_N=block_n)
+    return parts.sum(dim=1), bias_parts.sum(dim=1)
 
 
 class _PackedConvStride1(torch.autograd.Function):
-    """The stride-1, unpadded packed convolution: x [K, B, H, W, Cin] (bf16 or fp32), the grouped layout's weight
-    [K * Cout, Cin, kh, kw] and bias [K * Cout] (any float dtype) -> [K, B, OH, OW, Cout] in x's dtype. The
-    kernels compute in x's dtype with fp32 sums (fp32 master weights arrive as they are under autocast: cast
-    here); the gradients come back in their inputs' dtypes."""
+    """The stride-1, unpadded packed convolution, with its ReLU under `relu`: x [K, B, H, W, Cin] (bf16 or fp32),
+    the grouped layout's weight [K * Cout, Cin, kh, kw] and bias [K * Cout] (any float dtype) -> [K, B, OH, OW,
+    Cout] in x's dtype. The kernels compute in x's dtype with fp32 sums (fp32 master weights arrive as they are
+    under autocast: cast here); the gradients come back in their inputs' dtypes. The ReLU is the forward
+    kernel's epilogue, and its gradient is applied where the backward kernels read the incoming gradient: no
+    pass of its own either way."""
 
     @staticmethod
-    def forward(ctx, x, weight, bias):
+    def forward(ctx, x, weight, bias, relu):
         k, cin = x.shape[0], x.shape[-1]
         cout, kh, kw = weight.shape[0] // k, weight.shape[2], weight.shape[3]
         assert weight.shape[1] == cin and weight.shape[0] == k * cout, (x.shape, weight.shape)
         x = x.contiguous()
         w = weight.reshape(k, cout, cin, kh, kw).permute(0, 3, 4, 2, 1).contiguous().to(x.dtype)
-        ctx.save_for_backward(x, w)
-        ctx.weight_dtype, ctx.bias_dtype = weight.dtype, bias.dtype
-        return _forward(x, w, bias.to(torch.float32).contiguous())
+        y = _forward(x, w, bias.to(torch.float32).contiguous(), relu)
+        ctx.save_for_backward(x, w, y)
+        ctx.relu, ctx.weight_dtype, ctx.bias_dtype = relu, weight.dtype, bias.dtype
+        return y
 
     @staticmethod
     def backward(ctx, dy):
-        x, w = ctx.saved_tensors
+        x, w, y = ctx.saved_tensors
         k, _, h, wd, cin = x.shape
         _, kh, kw, _, cout = w.shape
         dy = dy.to(x.dtype).contiguous()
-        dx = _dgrad(dy, w, h, wd) if ctx.needs_input_grad[0] else None  # frames need none
+        dx = _dgrad(dy, y, w, h, wd, ctx.relu) if ctx.needs_input_grad[0] else None  # frames need none
         dw = db = None
-        if ctx.needs_input_grad[1]:
-            dw = _wgrad(x, dy, kh, kw).permute(0, 4, 3, 1, 2).reshape(k * cout, cin, kh, kw).to(ctx.weight_dtype)
-        if ctx.needs_input_grad[2]:
-            db = dy.sum(dim=(1, 2, 3), dtype=torch.float32).reshape(-1).to(ctx.bias_dtype)
-        return dx, dw, db
+        if ctx.needs_input_grad[1] or ctx.needs_input_grad[2]:
+            dw, db = _wgrad(x, dy, y, kh, kw, ctx.relu)
+            dw = dw.permute(0, 4, 3, 1, 2).reshape(k * cout, cin, kh, kw).to(ctx.weight_dtype)
+            db = db.reshape(-1).to(ctx.bias_dtype)
+        return dx, dw, db, None
 
 
-def packed_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int = 1) -> torch.Tensor:
+def packed_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int = 1,
+                relu: bool = False) -> torch.Tensor:
     """K runs' unpadded convolutions at once: x [K, B, H, W, Cin], weight [K * Cout, Cin, kh, kw] and bias
-    [K * Cout] as nn.Conv2d(groups=K) holds them -> [K, B, OH, OW, Cout]. A stride s > 1 (kernel a multiple of
-    s) becomes the equal stride-1 convolution of s x s blocks (space_to_depth), which the kernels run."""
+    [K * Cout] as nn.Conv2d(groups=K) holds them -> [K, B, OH, OW, Cout], through a ReLU under `relu`
+    (F.relu(packed_conv(...)) without the ReLU's passes). A stride s > 1 (kernel a multiple of s) becomes the
+    equal stride-1 convolution of s x s blocks (space_to_depth), which the kernels run."""
     if stride != 1:
         x, weight = space_to_depth(x, stride), weight_space_to_depth(weight, stride)
-    return _PackedConvStride1.apply(x, weight, bias)
-
+    return _PackedConvStride1.apply(x, weight, bias, relu)
