@@ -14,8 +14,8 @@ import sys
 import pytest
 
 from kage.bench import status
-from kage.ppo import train
-from support import CONFIGS, NOISY_SKELETON, ROOT
+from kage.ppo import checkpoint, train
+from support import CONFIGS, NOISY_SKELETON, ROOT, TINY_TRAINING
 
 FLAGS = ["--train-config-path", NOISY_SKELETON, "--device", "cpu", "--threads", "1", "--total-timesteps", "64",
          "--num-envs", "2", "--num-steps", "16", "--num-minibatches", "2", "--update-epochs", "1",
@@ -151,3 +151,129 @@ def test_a_damaged_bench_state_does_not_abort_status(tmp_path):
     for unit in ("list", "syntax", "no_time", "text_time", "no_host"):
         line = next(line for line in text.splitlines() if f"{unit} seed 1" in line)
         assert "bench_state.json" in line and "rewritten" in line, line
+
+
+def crafted(run, change):
+    """The run's checkpoint with `change` applied, written with a valid digest (a file made to pass the
+    integrity check: its content is what must be checked)."""
+    latest = run / "checkpoints" / "latest.pt"
+    state = checkpoint.load(str(latest))
+    change(state)
+    latest.write_bytes(checkpoint.encode(state))
+
+
+def first_parameter(state):
+    return next(iter(state["agent"]))
+
+
+@pytest.mark.parametrize("change, names", [
+    # copy_ broadcast a [1, ...] slice over the whole weight: the run went on with garbage
+    (lambda s: s["agent"].update({first_parameter(s): s["agent"][first_parameter(s)][..., :1]}), ["/agent/"]),
+    (lambda s: s["agent"].pop(first_parameter(s)), ["/agent", "lacks"]),
+    (lambda s: s.update(iteration=10**6), ["iteration 1000000"]),  # was "done", with no training
+    (lambda s: s.update(iteration="2"), ["/iteration"]),
+    (lambda s: s.update(env_state=b"garbage"), ["/env_state"]),
+    (lambda s: s.update(optimizer={}), ["/optimizer"]),
+    (lambda s: s.update(next_done=s["next_done"][:1]), ["/next_done"]),
+    (lambda s: s.update(history={}), ["/history"]),
+    (lambda s: s.update(log={}), ["does not record"]),  # was read as "no checkpoint": the log emptied
+    (lambda s: s["identity"].update(configs=[]), ["does not record"]),
+], ids=["parameter-shape", "parameter-missing", "iteration-beyond", "iteration-text", "env-state", "optimizer",
+        "loop-state", "history", "log", "identity"])
+def test_a_checkpoint_whose_content_is_not_this_runs_is_refused_by_name(tmp_path, finished, change, names):
+    run = tmp_path / "run"
+    shutil.copytree(finished, run)
+    (run / "summary.json").unlink()
+    crafted(run, change)
+    with pytest.raises(SystemExit) as caught:
+        train.main(FLAGS + ["--out", str(run)])
+    message = str(caught.value)
+    assert "\n" not in message and "latest.pt" in message and "another --out" in message, message
+    for name in names:
+        assert name in message, message
+    assert not (run / "summary.json").exists()
+
+
+@pytest.mark.parametrize("change, name", [
+    (lambda s: s["agent"].update({first_parameter(s): s["agent"][first_parameter(s)][..., :1]}), "/agent/"),
+    (lambda s: s["agent_spec"].update(observation_shape="128x128"), "/agent_spec/observation_shape"),
+    (lambda s: s["agent_spec"].update(num_actions=-1), "-1 actions"),
+    (lambda s: s.update(iteration="2"), "/iteration"),
+], ids=["parameter-shape", "observation-shape", "actions", "iteration"])
+def test_scoring_a_checkpoint_whose_content_is_not_a_policy_is_refused_by_name(tmp_path, finished, change, name):
+    run = tmp_path / "run"
+    shutil.copytree(finished, run)
+    crafted(run, change)
+    one_message(command("kage.ppo.evaluate", str(run), "--config", NOISY_SKELETON, "--out", str(tmp_path / "eval"),
+                        "--device", "cpu", "--episodes", "1", "--num-envs", "2"), "latest.pt", name)
+
+
+@pytest.mark.parametrize("configs", ['{"train": 3}', '{"train": {}}', '{"train": {"path": 1, "spec_sha256": "x"}}'])
+def test_a_run_json_whose_configs_are_not_described_is_refused(tmp_path, finished, configs):
+    run = tmp_path / "run"
+    shutil.copytree(finished, run)
+    (run / "summary.json").unlink()
+    (run / "run.json").write_text('{"args": {}, "configs": %s}' % configs)
+    one_message(command("kage.ppo.train", *FLAGS, "--out", str(run)), "run.json", "config 'train'")
+
+
+@pytest.mark.parametrize("content, name", [
+    ("{not json", "not JSON"), ("[]", "not a pack file"), ('{"runs": [3]}', "not a pack file"),
+    ('{"runs": []}', "not a pack file"), ('{"runs": [{"nope": 1}]}', "'nope' is not an argument"),
+    ('{"runs": [{"num_envs": "2"}]}', "'num_envs'"), ('{"runs": [{"gamma": true}]}', "'gamma'"),
+], ids=["syntax", "list", "run-not-object", "no-runs", "unknown", "text-count", "bool-number"])
+def test_a_damaged_pack_file_is_refused_by_name(tmp_path, content, name):
+    pack = tmp_path / "pack.json"
+    pack.write_text(content)
+    one_message(command("kage.ppo.train", "--pack", str(pack)), str(pack), name)
+
+
+@pytest.mark.parametrize("flags, name", [
+    (["--threads", "0"], "--threads"), (["--threads", "-1"], "--threads"),
+    (["--num-envs", str(2**40)], "--num-envs"), (["--seed", "-5"], "--seed"),
+    (["--num-envs", str(2**30), "--threads", "1"], "more than half"),  # make_vec's refusal, as one line
+    (["--config", "/"], "config '/'"),  # a folder without a compiled config
+])
+def test_scoring_flags_and_batches_that_cannot_be_made_end_in_a_message(tmp_path, finished, flags, name):
+    one_message(command("kage.ppo.evaluate", str(finished), "--config", NOISY_SKELETON, "--out", str(tmp_path / "e"),
+                        "--device", "cpu", "--episodes", "1", "--num-envs", "2", *flags), name)
+
+
+SUITE = "suite: names\npairs:\n  - name: alone\n    axis: background\n    train: {c}\n    eval: {c}\n"
+
+
+@pytest.mark.parametrize("command_name", ["run", "slurm"])
+def test_a_benchmark_out_that_is_a_file_ends_in_a_message(tmp_path, command_name):
+    (tmp_path / "suite.yaml").write_text(SUITE.format(c=NOISY_SKELETON))
+    (tmp_path / "taken").write_text("a file")
+    one_message(command("kage.bench", command_name, str(tmp_path / "suite.yaml"), "--seeds", "1", "--out",
+                        str(tmp_path / "taken"), *TINY_TRAINING), str(tmp_path / "taken"), "--out")
+
+
+@pytest.mark.parametrize("name, text, found", [
+    ("bench.json", "{", "not JSON"), ("bench.json", "[]", "not an object"),
+    ("bench.json", '{"units": 3, "seeds": [1], "trainer_args": []}', "'units'"),
+    ("bench.json", '{"units": ["alone"], "seeds": ["x"], "trainer_args": []}', "'seeds'"),
+    ("suite.json", "{", "not JSON"), ("suite.json", '{"pairs": [{"pair": "alone"}]}', "spec hashes"),
+], ids=["bench-syntax", "bench-list", "bench-units", "bench-seeds", "suite-syntax", "suite-shape"])
+def test_a_damaged_benchmark_record_is_refused_by_name_before_training(tmp_path, name, text, found):
+    (tmp_path / "suite.yaml").write_text(SUITE.format(c=NOISY_SKELETON))
+    bench = tmp_path / "bench"
+    bench.mkdir()
+    (bench / name).write_text(text)
+    done = command("kage.bench", "run", str(tmp_path / "suite.yaml"), "--seeds", "1", "--out", str(bench),
+                   *TINY_TRAINING)
+    one_message(done, str(bench / name), found, "another --out")
+    assert not (bench / "runs").exists()
+    if name == "bench.json":
+        one_message(command("kage.bench", "status", str(bench)), str(bench / name), found)
+
+
+def test_status_and_packing_read_a_damaged_latest_json_as_no_checkpoint(tmp_path):
+    bench = tmp_path / "bench"
+    for text in ("[]", '{"iteration": "3"}'):
+        (bench / "runs" / "alone" / "seed_1" / "checkpoints").mkdir(parents=True, exist_ok=True)
+        (bench / "runs" / "alone" / "seed_1" / "checkpoints" / "latest.json").write_text(text)
+        (bench / "bench.json").write_text(json.dumps({"units": ["alone"], "seeds": [1], "trainer_args": []}))
+        out = io.StringIO()
+        assert status.status(str(bench), out)["not started"] == ["alone seed 1"], out.getvalue()

@@ -127,8 +127,15 @@ def read_bench(bench_dir: str) -> dict:
     path = os.path.join(bench_dir, "bench.json")
     if not os.path.exists(path):
         return {}
-    bench = read_json(path, "fix or delete it (the report reads only its seeds and units)")
-    return bench if isinstance(bench, dict) else {}
+    fix = "fix or delete it (the report reads only its seeds and units)"
+    bench = read_json(path, fix)
+    if not isinstance(bench, dict):
+        return {}
+    for key, kind in (("units", str), ("seeds", int)):
+        if key in bench and not (isinstance(bench[key], list) and
+                                 all(isinstance(v, kind) and not isinstance(v, bool) for v in bench[key])):
+            fail(f"{path}: its '{key}' is not a list of {kind.__name__}s: {fix}")
+    return bench
 
 
 def find_runs(bench_dir: str, unit: Unit) -> List[Run]:

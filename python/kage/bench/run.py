@@ -43,7 +43,7 @@ from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
 from kage.bench.units import Unit, select, units_of
 from kage.errors import ConfigError
-from kage.util.files import atomic_write, remove_strays, write_json
+from kage.util.files import atomic_write, os_error_text, remove_strays, write_json
 from kage.util.lock import DirectoryLock, LockHeld
 from kage.util.stop import child_environment, die_with_parent, stop_children
 
@@ -116,13 +116,52 @@ def share_training(units: List[Unit], report: dict) -> List[Unit]:
     return [v for u in units for v in shared.get(u.name, [u])]
 
 
+def strings(value) -> bool:
+    return isinstance(value, list) and all(isinstance(v, str) for v in value)
+
+
+def bench_problem(bench, keys=("units", "seeds", "trainer_args")) -> Optional[str]:
+    """What bench.json's content lacks of `keys`: its units, seeds and trainer flags."""
+    if not isinstance(bench, dict):
+        return f"a JSON {type(bench).__name__}, not an object"
+    for key, valid in (("units", strings), ("trainer_args", strings), ("seeds", lambda v: isinstance(v, list) and all(
+            isinstance(s, int) and not isinstance(s, bool) for s in v))):
+        if key in keys and not valid(bench.get(key)):
+            return f"no valid '{key}'"
+    return None
+
+
+def suite_problem(suite) -> Optional[str]:
+    """What suite.json's content lacks: each pair's name and its two sides' spec hashes."""
+    pairs = suite.get("pairs") if isinstance(suite, dict) else None
+    if not isinstance(pairs, list) or not all(
+            isinstance(p, dict) and isinstance(p.get("pair"), str) and
+            all(isinstance(p.get(side), dict) and isinstance(p[side].get("spec_sha256"), str)
+                for side in ("train", "eval")) for p in pairs):
+        return "not a suite report with each pair's name and spec hashes"
+    return None
+
+
+def read_record(path: str, problem_of) -> dict:
+    """bench.json or suite.json of DIR, refused in one line where it is damaged."""
+    try:
+        with open(path) as f:
+            value = json.load(f)
+        problem = problem_of(value)
+    except ValueError as e:
+        problem = f"not JSON ({e})"
+    if problem:
+        raise SystemExit(f"kage.bench: {path} is damaged ({problem}): restore it, or delete it and run the same "
+                         "command again to write it anew (or use another --out)")
+    return value
+
+
 def check_suite_unchanged(out: str, report: dict) -> None:
     """Refuses a DIR started on configs whose Specs have changed since."""
     path = os.path.join(out, "suite.json")
     if not os.path.exists(path):
         return
-    with open(path) as f:
-        before = {p["pair"]: p for p in json.load(f)["pairs"]}
+    before = {p["pair"]: p for p in read_record(path, suite_problem)["pairs"]}
     for p in report["pairs"]:
         old = before.get(p["pair"])
         if old is None:
@@ -144,8 +183,7 @@ def record_bench(out: str, manifest: str, seeds: List[int], units: List[Unit], t
     names = [u.name for u in units]
     shared = {p["pair"]: [u.name, u.label(p)] for u in units if u.shared for p in u.pairs}
     if os.path.exists(path):
-        with open(path) as f:
-            previous = json.load(f)
+        previous = read_record(path, bench_problem)
         if previous["trainer_args"] != trainer_args:
             raise SystemExit(f"kage.bench: {out} was started with trainer flags {previous['trainer_args']}, now "
                              f"{trainer_args}: use the same flags (results must share one protocol), or another --out")
@@ -169,9 +207,10 @@ def checkpoint_iteration(run_dir: str) -> int:
     """The iteration of a run's last checkpoint (0 for none)."""
     try:
         with open(os.path.join(run_dir, "checkpoints", "latest.json")) as f:
-            return json.load(f)["iteration"]
-    except (OSError, ValueError, KeyError):
+            iteration = json.load(f)["iteration"]
+    except (OSError, ValueError, KeyError, TypeError):
         return 0
+    return iteration if isinstance(iteration, int) and not isinstance(iteration, bool) else 0
 
 
 def packs_of(jobs: List[tuple], size: int) -> List[List[tuple]]:
@@ -437,6 +476,14 @@ def main(argv: List[str]) -> int:
                                        "tasks until none is left")
     args, trainer_args = parser.parse_known_args(argv)
     die_with_parent()  # a --task worker of --gpus stops with its runner
+    try:
+        return run_command(args, trainer_args)
+    except OSError as e:  # a DIR the file system refuses: a file, read-only, full, no permission
+        raise SystemExit(os_error_text("kage.bench run", e, "--out")) from None
+
+
+def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
+    """main() without its handling of file-system errors."""
     if args.task is not None and args.gpus:
         raise SystemExit("kage.bench run: --task and --gpus exclude each other: --gpus runs the tasks itself")
     bench = plan(args, trainer_args)

@@ -20,7 +20,7 @@ import sys
 from typing import List
 
 from kage.bench import run, tasks
-from kage.util.files import atomic_write
+from kage.util.files import atomic_write, os_error_text
 
 PATH_FLAGS = ("--asset-root",)  # trainer flags that name a path: made absolute for the tasks
 
@@ -127,6 +127,14 @@ def main(argv: List[str]) -> int:
         value = getattr(args, name)
         if value is not None and value < (1 if name == "array_parallelism" else 0):
             raise SystemExit(f"kage.bench slurm: --{name.replace('_', '-')} {value}: out of range")
+    try:
+        return write_script(args, trainer_args)
+    except OSError as e:  # a DIR the file system refuses: a file, read-only, full, no permission
+        raise SystemExit(os_error_text("kage.bench slurm", e, "--out")) from None
+
+
+def write_script(args: argparse.Namespace, trainer_args: List[str]) -> int:
+    """main() once its flags are checked, without its handling of file-system errors."""
     bench = run.plan(args, absolute_paths(trainer_args))
     table = bench.table()
     text = script(bench, table, args)  # its values checked before anything is written

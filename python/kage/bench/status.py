@@ -7,7 +7,7 @@ import time
 from typing import Dict, List, TextIO
 
 from kage.bench import run_state
-from kage.bench.run import checkpoint_iteration
+from kage.bench.run import bench_problem, checkpoint_iteration
 from kage.bench.tasks import run_dir
 
 ORDER = ("done", "running", "failed", "interrupted", "not started")
@@ -44,12 +44,16 @@ def classify(path: str, now: float) -> tuple:
 
 def status(bench_dir: str, out: TextIO) -> Dict[str, List[str]]:
     """Prints the benchmark's state; returns category -> the runs in it."""
+    path = os.path.join(bench_dir, "bench.json")
     try:
-        with open(os.path.join(bench_dir, "bench.json")) as f:
+        with open(path) as f:
             bench = json.load(f)
+        problem = bench_problem(bench, ("units", "seeds"))
     except (OSError, ValueError) as e:
-        raise SystemExit(f"{os.path.join(bench_dir, 'bench.json')}: error: {getattr(e, 'strerror', None) or e}: "
-                         "not a directory written by python3 -m kage.bench run (or slurm)") from None
+        problem = getattr(e, "strerror", None) or f"not JSON ({e})"
+    if problem:
+        raise SystemExit(f"{path}: error: {problem}: not a directory written by python3 -m kage.bench run (or slurm), "
+                         "or that file is damaged (restore it, or run the benchmark's command again to rewrite it)")
     now = time.time()
     found: Dict[str, List[tuple]] = {c: [] for c in ORDER}
     for unit in bench["units"]:

@@ -116,8 +116,7 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
     namespace = vars(parser.parse_args(argv))
     pack = namespace.pop("pack")
     if pack:
-        with open(pack) as f:
-            runs = [Args(**run) for run in json.load(f)["runs"]]
+        runs = read_pack(pack, parser)
         for args in runs:
             problems = validate(args)
             if problems:
@@ -128,6 +127,48 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
     if problems:
         parser.error("; ".join(problems))
     return args
+
+
+def read_pack(path: str, parser: argparse.ArgumentParser) -> List[Args]:
+    """The runs of a --pack file ({"runs": [arguments, ...]}, written by kage.bench), each value of its field's
+    kind; anything else is refused naming the file (an OSError is left to the trainer's one line)."""
+    fix = "let kage.bench run write it again, or give the run's flags on the command line"
+    with open(path) as f:
+        try:
+            runs = json.load(f)
+        except ValueError as e:
+            parser.error(f"--pack {path}: not JSON ({e}): {fix}")
+    runs = runs.get("runs") if isinstance(runs, dict) else None
+    if not isinstance(runs, list) or not runs or not all(isinstance(run, dict) for run in runs):
+        parser.error(f"--pack {path}: not a pack file (an object whose \"runs\" lists each run's arguments): {fix}")
+    kinds = {f.name: f.type for f in dataclasses.fields(Args)}
+    for number, run in enumerate(runs, 1):
+        wrong = [f"'{k}' is not an argument" if k not in kinds else f"'{k}': {v!r:.40} is not {kind_name(kinds[k])}"
+                 for k, v in run.items() if k not in kinds or not of_kind(v, kinds[k])]
+        if wrong:
+            parser.error(f"--pack {path}: run {number}: {'; '.join(wrong)}: {fix}")
+    return [Args(**run) for run in runs]
+
+
+def of_kind(value, kind) -> bool:
+    """Whether a JSON value is one of an Args field's type (a float field takes an int, never a bool)."""
+    if kind in (Optional[int], Optional[float], Optional[str]) and value is None:
+        return True
+    if kind == List[str]:
+        return isinstance(value, list) and all(isinstance(v, str) for v in value)
+    if kind is bool:
+        return isinstance(value, bool)
+    if isinstance(value, bool):
+        return False
+    if kind in (float, Optional[float]):
+        return isinstance(value, (int, float))
+    return isinstance(value, int if kind in (int, Optional[int]) else str)
+
+
+def kind_name(kind) -> str:
+    return {bool: "a boolean", int: "an integer", float: "a number", str: "a string", List[str]: "a list of strings",
+            Optional[int]: "an integer or null", Optional[float]: "a number or null",
+            Optional[str]: "a string or null"}.get(kind, str(kind))
 
 
 MAX_INT32 = 2**31 - 1  # the environment API's counts are int32

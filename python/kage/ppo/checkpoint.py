@@ -17,7 +17,7 @@ in use can (2.x); nothing is ever unpickled beyond what that loader allows.
 import hashlib
 import io
 import json
-from typing import Any, List
+from typing import Any, List, Optional
 
 import numpy as np
 import torch
@@ -129,3 +129,45 @@ def _decode(path: str, raw: dict) -> dict:
     if not (isinstance(state, dict) and "agent" in state and "iteration" in state):
         raise CheckpointError(f"{path}: not a kage.ppo.train checkpoint (no parameters and iteration)")
     return state
+
+
+def structure_problem(expected: Any, found: Any, where: str = "") -> Optional[str]:
+    """Where a decoded checkpoint `found` is not shaped like `expected` (the one this code would write now), or
+    None: dicts with the same keys, tensors of the same dtype and shape, bytes of the same length, lists, and
+    numbers, strings, booleans and None of the same kind (a float may be an int). A digest proves a file intact,
+    not that its writer wrote what a run needs: this turns a crafted or foreign file into a message."""
+    at = where or "the top level"
+    if isinstance(expected, np.generic):  # written as its Python value (encode)
+        expected = expected.item()
+    if isinstance(expected, dict):
+        if not isinstance(found, dict):
+            return f"{at}: {_kind(found)}, expected a dict"
+        if found.keys() != expected.keys():
+            missing, extra = sorted(expected.keys() - found.keys()), sorted(found.keys() - expected.keys())
+            return f"{at}: " + "; ".join(filter(None, [missing and f"lacks {', '.join(missing[:4])}",
+                                                      extra and f"has unknown {', '.join(map(str, extra[:4]))}"]))
+        for key, value in expected.items():
+            problem = structure_problem(value, found[key], f"{where}/{key}")
+            if problem:
+                return problem
+        return None
+    if isinstance(expected, torch.Tensor):
+        if not isinstance(found, torch.Tensor) or found.dtype != expected.dtype or found.shape != expected.shape:
+            shown = f"{found.dtype} {list(found.shape)}" if isinstance(found, torch.Tensor) else _kind(found)
+            return f"{at}: {shown}, expected {expected.dtype} {list(expected.shape)}"
+        return None
+    if isinstance(expected, bytes):
+        if not isinstance(found, bytes) or len(found) != len(expected):
+            shown = f"{len(found)} bytes" if isinstance(found, bytes) else _kind(found)
+            return f"{at}: {shown}, expected {len(expected)} bytes"
+        return None
+    kinds = {bool: (bool,), int: (int,), float: (int, float), str: (str,), list: (list,), type(None): (type(None),)}
+    allowed = kinds.get(type(expected), (type(expected),))
+    if not isinstance(found, allowed) or (isinstance(found, bool) and not isinstance(expected, bool)):
+        return f"{at}: {_kind(found)}, expected {_kind(expected)}"
+    return None
+
+
+def _kind(value: Any) -> str:
+    name = type(value).__name__
+    return f"{'an' if name[0] in 'aeiou' else 'a'} {name}" if value is not None else "null"

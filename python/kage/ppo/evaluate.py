@@ -24,6 +24,7 @@ import torch
 import kage
 from kage import resources
 from kage.ppo import checkpoint, plugins, rundir, video
+from kage.ppo.args import MAX_INT32
 from kage.errors import ConfigError
 from kage.util import tables
 from kage.ppo.evaluation import METRICS, EvalSettings, evaluate, evaluation_seed
@@ -51,17 +52,38 @@ def load_policy(file: str, device: str, agent_flag: Optional[str] = None):
         state = checkpoint.load(file)
     except checkpoint.CheckpointError as e:
         fail(str(e))
-    spec = dict(state.get("agent_spec") or spec_from_run_dir(file))
-    spec["agent"] = agent_to_import(file, plugins.current_reference(spec["agent"]), agent_flag)
+    spec = state.get("agent_spec") or spec_from_run_dir(file)
+    problem = policy_problem(state, spec)
+    if problem:
+        fail(f"{file}: not a policy this command can score ({problem}): give a checkpoint that kage.ppo.train wrote")
+    spec = dict(spec, agent=agent_to_import(file, plugins.current_reference(spec["agent"]), agent_flag))
     agent = plugins.build_agent(spec["agent"], spec["observation_shape"], spec["num_actions"], [spec["seed"]], device)
+    problem = checkpoint.structure_problem({n: agent.run_view(p)[0] for n, p in agent.named_parameters()},
+                                           state["agent"], "/agent")
+    if problem:
+        fail(f"{file}: its parameters are not those of --agent {spec['agent']} ({problem}): the agent's code changed "
+             "since the run; evaluate with the code it was trained with")
     with torch.no_grad():
         for name, p in agent.named_parameters():
-            if name not in state["agent"]:
-                fail(f"{file} has no parameter '{name}' for --agent {spec['agent']}: the agent's code changed since "
-                     "the run; evaluate with the code it was trained with")
             agent.run_view(p)[0].copy_(state["agent"][name])
     agent.eval()
     return agent, spec, state
+
+
+def policy_problem(state: dict, spec) -> Optional[str]:
+    """What a checkpoint lacks for scoring: the network's description (agent_spec) and its counters."""
+    problem = checkpoint.structure_problem(
+        {"agent": "", "observation_shape": [], "num_actions": 0, "use_frame_stack": False, "seed": 0}, spec,
+        "/agent_spec") or checkpoint.structure_problem({"iteration": 0, "global_step": 0},
+                                                       {k: state.get(k) for k in ("iteration", "global_step")})
+    if problem:
+        return problem
+    shape = spec["observation_shape"]
+    if not (len(shape) == 3 and all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in shape) and
+            spec["num_actions"] > 0 and spec["seed"] >= 0 and state["iteration"] >= 0 and state["global_step"] >= 0):
+        return (f"observation shape {shape}, {spec['num_actions']} actions, seed {spec['seed']}, iteration "
+                f"{state['iteration']}, step {state['global_step']}")
+    return None
 
 
 def agent_to_import(file: str, recorded: str, agent_flag: Optional[str]) -> str:
@@ -107,7 +129,9 @@ def open_env(config: str, num_envs: int, spec: dict, file: str, options) -> "kag
         env = kage.make_vec(config, num_envs, device=options.device, asset_root=options.asset_root,
                             threads=options.threads)
     except ConfigError as e:
-        fail(f"{e}\nkage.evaluate: fix the config first")
+        fail(f"{e}\nkage.ppo.evaluate: config '{config}' has the errors above: fix the config first")
+    except (ValueError, RuntimeError, OSError) as e:  # too large for the memory, no GPU, not a config
+        fail(f"config '{config}': {e}")
     h, w, c = env.single_observation_space.shape
     shape = [h, w, c * (4 if spec["use_frame_stack"] else 1)]
     if shape != list(spec["observation_shape"]) or env.single_action_space.n != spec["num_actions"]:
@@ -162,6 +186,10 @@ def load_for_scoring(parser: argparse.ArgumentParser, options):
     to the run's seed where --seed is not given."""
     if options.episodes < 1 or options.num_envs < 1:
         parser.error("--episodes and --num-envs must be positive")
+    if options.num_envs > MAX_INT32 or (options.threads is not None and not 0 < options.threads <= MAX_INT32):
+        parser.error(f"--num-envs and --threads: positive, at most {MAX_INT32}")
+    if options.seed is not None and not 0 <= options.seed < 2**63:
+        parser.error(f"--seed {options.seed}: in [0, 2**63)")
     if options.device not in ("cuda", "cpu"):
         parser.error(f"--device {options.device}: use cuda or cpu")
     if options.device == "cuda" and not torch.cuda.is_available():

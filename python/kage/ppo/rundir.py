@@ -213,10 +213,13 @@ class RunDir:
     def _check_identity(self, path: str, state: dict) -> None:
         """Refuses a checkpoint that records other arguments or configs than this run's (another seed's copied in,
         or one written before checkpoints recorded them)."""
-        recorded = state.get("identity")
-        if not isinstance(recorded, dict) or not isinstance(state.get("log"), dict):
+        recorded, log = state.get("identity"), state.get("log")
+        if not (isinstance(recorded, dict) and isinstance(recorded.get("args"), dict) and
+                isinstance(recorded.get("configs"), dict) and isinstance(log, dict) and
+                all(isinstance(log.get(k), int) and log[k] >= 0 for k in ("bytes", "rows")) and
+                isinstance(log.get("sha256"), str)):
             raise SystemExit(f"kage.ppo.train: {path} does not record the arguments, configs and log it belongs to "
-                             "(an earlier kage.ppo.train wrote it), so it cannot be proven to be this run's: finish "
+                             "(an earlier kage.ppo.train wrote it, or it was edited), so it cannot be proven to be this run's: finish "
                              "the run with that version, or train anew with another --out")
         problems = [f"{k}: {v!r} in the checkpoint, {self.identity['args'][k]!r} now"
                     for k, v in changed_arguments(recorded["args"], self.identity["args"])]
@@ -272,13 +275,23 @@ def read_run_json(path: str) -> dict:
     try:
         with open(path) as f:
             run = json.load(f)
-        problem = None if isinstance(run, dict) and isinstance(run.get("args"), dict) and \
-            isinstance(run.get("configs"), dict) else "it lacks the run's arguments and configs"
+        problem = run_json_problem(run)
     except ValueError as e:
         problem = f"not JSON ({e})"
     if problem:
         raise SystemExit(f"kage.ppo.train: {path}: {problem}: restore it from a copy, or train anew with another --out")
     return run
+
+
+def run_json_problem(run) -> Optional[str]:
+    """What a run.json's content lacks: its arguments, and each config's path and spec hash."""
+    if not (isinstance(run, dict) and isinstance(run.get("args"), dict) and isinstance(run.get("configs"), dict)):
+        return "it lacks the run's arguments and configs"
+    for label, config in run["configs"].items():
+        if not (isinstance(config, dict) and isinstance(config.get("path"), str) and
+                isinstance(config.get("spec_sha256"), str)):
+            return f"config {label!r} is not described by a path and a spec_sha256"
+    return None
 
 
 def describe_or_check(path: str, args, configs: List[Tuple[str, str]], specs: Dict[str, dict],

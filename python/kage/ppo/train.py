@@ -31,6 +31,7 @@ the log. A run directory holds everything needed to resume a killed run exactly 
 """
 import contextlib
 import dataclasses
+import math
 import os
 import sys
 import time
@@ -40,7 +41,7 @@ from typing import Dict, List, Optional
 import torch
 
 import kage
-from kage.ppo import plugins, rundir, tensorboard_log, video
+from kage.ppo import checkpoint, plugins, rundir, tensorboard_log, video
 from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args
 from kage.ppo.counter_random import CounterRandom
 from kage.ppo.evaluation import METRICS, EpisodeMetrics, EvalSettings, EvalTargets, evaluation_rows
@@ -113,7 +114,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         """The runs' current observations, [K, N, H, W, C]."""
         return stack.stack if stack else torch.stack(frames)
 
-    if resume(runs, agent, optimizer, state, stack, normalizer, boards, device):
+    if resume(runs, agent, optimizer, state, stack, normalizer, boards, device, agent_spec):
         pass
     elif runs[0].eval_envs:
         with timer("eval"):  # §3.1: the untrained policy
@@ -378,19 +379,53 @@ def save_checkpoints(runs: List[Run], agent, optimizer, state: LoopState, stack,
     """Each run's checkpoint (kage.ppo.rundir): its parameters and optimizer state, its environments' state, and
     its part of the loop state."""
     for k, run in enumerate(runs):
-        checkpoint = {
-            "iteration": state.iteration, "global_step": state.global_step, "optimizer_steps": state.optimizer_steps,
-            "train_seconds": state.train_seconds,
-            "agent": {n: agent.run_view(p)[k].detach().cpu().clone() for n, p in agent.named_parameters()},
-            "optimizer": rundir.optimizer_run_state(optimizer, agent, k), "env_state": run.env.save_state(),
-            "frame_stack": stack.stack[k].cpu() if stack else None,
-            "normalizer": {n: v[k].cpu() for n, v in normalizer.state_dict().items()} if normalizer else None,
-            "history": run.history, "agent_spec": dict(agent_spec, seed=run.args.seed)}
-        checkpoint.update({key: getattr(state, key)[k].cpu() for key in LoopState.TENSORS})
-        run.dir.save_checkpoint(checkpoint)
+        run.dir.save_checkpoint(run_checkpoint(k, run, agent, rundir.optimizer_run_state(optimizer, agent, k), state,
+                                               stack, normalizer, agent_spec))
 
 
-def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalizer, boards, device) -> bool:
+def run_checkpoint(k: int, run: Run, agent, optimizer_state: dict, state: LoopState, stack, normalizer,
+                   agent_spec: dict) -> dict:
+    """Run `k`'s checkpoint as a dict of data (kage.ppo.checkpoint)."""
+    saved = {
+        "iteration": state.iteration, "global_step": state.global_step, "optimizer_steps": state.optimizer_steps,
+        "train_seconds": state.train_seconds,
+        "agent": {n: agent.run_view(p)[k].detach().cpu().clone() for n, p in agent.named_parameters()},
+        "optimizer": optimizer_state, "env_state": run.env.save_state(),
+        "frame_stack": stack.stack[k].cpu() if stack else None,
+        "normalizer": {n: v[k].cpu() for n, v in normalizer.state_dict().items()} if normalizer else None,
+        "history": run.history, "agent_spec": dict(agent_spec, seed=run.args.seed)}
+    saved.update({key: getattr(state, key)[k].cpu() for key in LoopState.TENSORS})
+    return saved
+
+
+def checkpoint_problem(c: dict, k: int, run: Run, agent, state: LoopState, stack, normalizer, agent_spec: dict,
+                       args: Args) -> Optional[str]:
+    """What keeps run `k` from resuming from checkpoint `c` (already proven intact and this run's): its parts must
+    be shaped as this run writes them, and its counters those of a whole number of iterations."""
+    adam = {n: {"exp_avg": t, "exp_avg_sq": t, "step": torch.zeros(())} for n, t in
+            ((n, agent.run_view(p)[k].detach().cpu()) for n, p in agent.named_parameters())}
+    expected = run_checkpoint(k, run, agent, adam, state, stack, normalizer, agent_spec)
+    expected.update(history=c.get("history"), identity=c.get("identity"), log=c.get("log"))  # rundir checks these
+    found = dict(c, optimizer={n: s if s or n not in adam else adam[n] for n, s in c["optimizer"].items()}) \
+        if isinstance(c.get("optimizer"), dict) else c  # a parameter Adam never stepped has no state
+    problem = checkpoint.structure_problem(expected, found)
+    if problem:
+        return problem
+    if not isinstance(c["history"], list) or not all(
+            isinstance(row, dict) and all(isinstance(row.get(key), dict) for key in ("train", "evals", "diffs")) and
+            isinstance(row.get("iteration"), int) and isinstance(row.get("global_step"), int) for row in c["history"]):
+        return "/history: not a list of evaluation rows"
+    i = c["iteration"]
+    if not (1 <= i <= args.num_iterations and c["global_step"] == i * args.batch_size and
+            c["optimizer_steps"] == i * args.update_epochs * args.num_minibatches and
+            math.isfinite(c["train_seconds"]) and c["train_seconds"] >= 0):
+        return (f"its counters (iteration {i}, global_step {c['global_step']}, optimizer_steps {c['optimizer_steps']}, "
+                f"train_seconds {c['train_seconds']}) are not those of a run of {args.num_iterations} iterations")
+    return None
+
+
+def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalizer, boards, device,
+           agent_spec: dict) -> bool:
     """Loads the runs' checkpoints, if they have any, into the network, optimizer, environments and loop state;
     whether they had."""
     checkpoints = [run.dir.load_checkpoint() for run in runs]
@@ -399,6 +434,12 @@ def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalize
     if any(c is None or c["iteration"] != checkpoints[0]["iteration"] for c in checkpoints):
         raise SystemExit("kage.ppo.train: packed runs resume together from checkpoints of one iteration; "
                          "pack them by the iteration they reached")
+    for k, (run, c) in enumerate(zip(runs, checkpoints)):
+        problem = checkpoint_problem(c, k, run, agent, state, stack, normalizer, agent_spec, run.args)
+        if problem:
+            raise SystemExit(f"kage.ppo.train: {os.path.join(run.dir.path, 'checkpoints', 'latest.pt')}: not a "
+                             f"checkpoint this run can resume from ({problem}): restore this run's checkpoint, or "
+                             "train anew with another --out")
     for k, (run, c) in enumerate(zip(runs, checkpoints)):
         with torch.no_grad():
             for name, p in agent.named_parameters():
