@@ -17,6 +17,11 @@ _DLPACK_CPU, _DLPACK_CUDA, _DLPACK_CUDA_HOST, _DLPACK_CUDA_MANAGED = 1, 2, 3, 13
 def submit(handle, actions) -> None:
     """Steps ``handle`` with ``actions``; raises ValueError for a wrong shape, dtype, device or value."""
     n = handle.num_envs
+    if isinstance(actions, np.ma.MaskedArray):  # an ndarray whose hidden values the binding would read
+        if np.ma.getmaskarray(actions).any():
+            raise ValueError("actions: a masked array with masked elements: fill them (actions.filled(value)) or "
+                             "pass a plain array")
+        actions = actions.data
     if hasattr(actions, "__dlpack_device__"):
         device_type, _ = actions.__dlpack_device__()
         if device_type in (_DLPACK_CUDA, _DLPACK_CUDA_MANAGED):

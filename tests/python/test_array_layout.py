@@ -67,6 +67,16 @@ def test_host_actions_of_any_layout_step_as_their_values(make, expected):
     assert state_after(actions) == expected
 
 
+def test_a_masked_array_steps_as_its_values_or_is_refused(expected):
+    # Nothing masked: the values. A masked element has no value: refused, never the hidden number behind it.
+    assert state_after(np.ma.masked_array(ACTIONS, mask=False)) == expected
+    hidden = np.ma.masked_array(ACTIONS, mask=[False, True, False, False, False, False])
+    with kage.make_vec(SIMPLEST, N, threads=1) as env:
+        env.reset(seed=5)
+        with pytest.raises(ValueError, match="a masked array with masked elements"):
+            env.step(hidden)
+
+
 def test_broadcast_actions_are_one_value_for_all():
     assert state_after(np.broadcast_to(np.int64(6), (N,))) == state_after(np.full(N, 6))
 
