@@ -32,16 +32,24 @@ std::string gib_text(uint64_t bytes) {
   return s.str();
 }
 
+std::string memory_refusal(const LoweredConfig& config, int64_t num_envs, int64_t num_threads) {
+  const uint64_t need = batch_bytes_estimate(config, num_envs, num_threads), have = physical_memory_bytes();
+  if (!have || need <= have / 2) return "";
+  // Name what takes the memory: the environments, or the threads' render scratch.
+  const uint64_t for_threads = batch_bytes_estimate(config, 0, num_threads);
+  return "cannot build " + std::to_string(num_envs) + " environments of " + std::to_string(config.visual.H) + "x" +
+         std::to_string(config.visual.W) + " observations on " + std::to_string(num_threads) + " threads: they need " +
+         gib_text(need) + " (" + gib_text(for_threads) + " of it the threads' render scratch), more than half of this " +
+         "machine's " + gib_text(have) +
+         (for_threads > need / 2 ? "; use fewer threads" : "; use fewer environments or smaller observations");
+}
+
 EnvironmentResult Environment::from_lowered(const LoweredConfig& config, const EnvironmentOptions& options) {
   EnvironmentResult result;
   // Refused before anything is allocated: a batch larger than half the machine would fail or swap.
-  const uint64_t need = batch_bytes_estimate(config, options.num_envs, options.num_threads);
-  const uint64_t have = physical_memory_bytes();
-  if (have && need > have / 2) {
-    result.error = "cannot build " + std::to_string(options.num_envs) + " environments of " +
-                   std::to_string(config.visual.H) + "x" + std::to_string(config.visual.W) + " observations: they need " +
-                   gib_text(need) + ", more than half of this machine's " + gib_text(have) +
-                   "; use fewer environments or smaller observations\n";
+  result.error = memory_refusal(config, options.num_envs, options.num_threads);
+  if (!result.error.empty()) {
+    result.error += "\n";
     return result;
   }
   AssetPackResult loaded = load_asset_pack(config.assets);

@@ -27,6 +27,9 @@ uint64_t batch_bytes_estimate(const LoweredConfig& config, int64_t num_envs, int
 uint64_t physical_memory_bytes();
 /// "1.5 GiB".
 std::string gib_text(uint64_t bytes);
+/// Why a CPU batch of this configuration does not fit (more than half of the machine's memory), naming
+/// whether the environments or the threads take it and the fix; empty when it fits.
+std::string memory_refusal(const LoweredConfig& config, int64_t num_envs, int64_t num_threads);
 
 /// Result of Environment::open: `env`, or the diagnostics / loading errors as text in `error`.
 struct [[nodiscard]] EnvironmentResult {

@@ -348,12 +348,8 @@ bool fits_in_memory(const LatentParams& latent, const VisualParams& visual, cons
   LoweredConfig config;
   config.latent = latent;
   config.visual = visual;
-  const uint64_t need = batch_bytes_estimate(config, o.num_envs, o.num_threads), have = physical_memory_bytes();
-  if (!have || need <= have / 2) return true;
-  return fail(error, "kage::open: " + std::to_string(o.num_envs) + " environments of " + std::to_string(visual.H) +
-                         "x" + std::to_string(visual.W) + " observations need " + gib_text(need) +
-                         ", more than half of this machine's " + gib_text(have) +
-                         ": use fewer environments or smaller observations");
+  const std::string refusal = memory_refusal(config, o.num_envs, o.num_threads);
+  return refusal.empty() || fail(error, "kage::open: " + refusal);
 }
 
 /// open() without the final error kind: sets *kind where a failure has a specific one.

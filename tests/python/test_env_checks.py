@@ -90,8 +90,12 @@ def test_arguments_the_binding_cannot_take_are_value_errors(kwargs, match):
 
 
 def test_a_batch_larger_than_the_machine_is_refused_before_allocating():
-    with pytest.raises(ValueError, match="more than half of this machine's"):
+    with pytest.raises(ValueError, match="more than half of this machine's") as e:
         kage.make_vec(SIMPLEST, 2**30, threads=1)
+    assert "use fewer environments" in str(e.value)
+    # Two environments on a million threads: the threads' render scratch is what does not fit.
+    with pytest.raises(ValueError, match="on 1000000 threads.*the threads' render scratch.*use fewer threads"):
+        kage.make_vec(SIMPLEST, 2, threads=10**6)
 
 
 def test_a_config_that_is_not_utf8_gives_a_located_config_error(tmp_path):
