@@ -59,6 +59,16 @@ def test_the_default_cuda_device_without_a_gpu_writes_nothing(tmp_path):
     assert train.main(BASE + ["--device", "cpu", "--out", str(out)]) == 0
 
 
+def test_the_benchmark_runner_refuses_the_default_cuda_device_without_a_gpu_before_writing(tmp_path):
+    if torch.cuda.is_available():
+        pytest.skip("reported skip: this machine has a GPU, so --device cuda is not refused here")
+    from kage.bench import run
+    out = tmp_path / "bench"
+    with pytest.raises(SystemExit, match="torch sees no GPU here: add --device cpu"):
+        run.main(["kage_bench", "--pairs", "background/1", "--seeds", "1", "--out", str(out), *BASE[4:]])
+    assert not out.exists()
+
+
 def test_a_pack_file_is_checked_as_the_command_line_is(tmp_path):
     runs = [vars(train.parse_args(BASE + ["--device", "cpu", "--out", str(tmp_path / f"run{i}")])) for i in (1, 2)]
     for run in runs:

@@ -323,11 +323,6 @@ def add_bench_arguments(parser: argparse.ArgumentParser) -> None:
                         help="train pairs that share a train config once per seed, evaluating all their eval configs")
 
 
-def prepare(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
-    """plan(), then record()."""
-    return record(plan(args, trainer_args))
-
-
 def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
     """Checks the arguments, the trainer flags and the suite, writing nothing. The suite and DIR are named by
     absolute paths from here on, so that every process of the benchmark resolves the same configs wherever it
@@ -487,6 +482,11 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
     if args.task is not None and args.gpus:
         raise SystemExit("kage.bench run: --task and --gpus exclude each other: --gpus runs the tasks itself")
     bench = plan(args, trainer_args)
+    if bench.device == "cuda":
+        import torch  # here: kage.bench slurm plans on machines without torch's GPU build
+        if not torch.cuda.is_available():  # every run would fail alone, each in its own train.log
+            raise SystemExit("kage.bench run: --device cuda (the trainer's default), but torch sees no GPU here: "
+                             "add --device cpu, or run on a GPU machine (kage.bench slurm writes a cluster job)")
     devices = gpus.parse_gpus(args.gpus, bench.device) if args.gpus else None
     held = lock_bench(bench.out, args.task)
     try:
