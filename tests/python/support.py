@@ -1,4 +1,5 @@
 """Paths and a deterministic policy shared by the Python tests (tests/python, tests/gpu)."""
+import os
 import pathlib
 
 import numpy as np
@@ -22,3 +23,16 @@ def policy(seed: int, num_envs: int, steps: int) -> np.ndarray:
 TINY_TRAINING = ["--total-timesteps", "64", "--num-envs", "2", "--num-steps", "32", "--num-minibatches", "2",
                  "--update-epochs", "1", "--run-eval-every", "1", "--eval-episodes", "2", "--eval-num-envs", "2",
                  "--device", "cpu", "--threads", "1"]
+
+
+def dead_pid() -> int:
+    """A process id that no process has now."""
+    pid = 2**22 - 1
+    while True:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return pid
+        except PermissionError:
+            pass
+        pid -= 1

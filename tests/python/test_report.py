@@ -3,10 +3,12 @@ directory written by hand with known per-run maxima. Every expected number is wo
 import csv
 import json
 import math
+import socket
 
 import pytest
 
 from kage.bench import report, tables
+from support import dead_pid
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 METRICS = ("passed_distance", "progress", "success", "success_once", "return", "length", "jump_count")
@@ -109,6 +111,17 @@ def bench(tmp_path_factory):
             "eval/1.0/success_once": e10}, rows=[eval_row(0, t, {"0.0": e00, "0.5": e05, "1.0": e10})])
     result = report.report(str(bench))
     return bench, result
+
+
+def test_a_killed_reports_temporary_files_are_removed_by_the_next_report(bench):
+    path, _ = bench
+    host = socket.gethostname()
+    strays = [path / "report" / f"axes.md.tmp.{host}.{dead_pid()}.ab12cd",
+              path / "report" / "plots" / f"drop_per_axis.png.tmp.{host}.{dead_pid()}.cd34ef"]
+    for stray in strays:
+        stray.write_bytes(b"\0" * 4096)
+    report.report(str(path))
+    assert not any(stray.exists() for stray in strays)
 
 
 def by_name(entries, key, name):

@@ -9,7 +9,7 @@ import pytest
 
 from kage.ppo import train
 from kage.util import files
-from support import NOISY_SKELETON
+from support import NOISY_SKELETON, dead_pid
 
 FLAGS = ["--train-config-path", NOISY_SKELETON, "--seed", "2", "--device", "cpu", "--threads", "1",
          "--total-timesteps", "32", "--num-envs", "2", "--num-steps", "16", "--num-minibatches", "2",
@@ -52,19 +52,6 @@ def test_a_failed_write_leaves_no_stray(tmp_path, monkeypatch, error):
         files.atomic_write(str(tmp_path / "summary.json"), b"x" * 100000)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]
     assert (tmp_path / "summary.json").read_text() == "old"
-
-
-def dead_pid() -> int:
-    """A process id that no process has now."""
-    pid = 2**22 - 1
-    while True:
-        try:
-            os.kill(pid, 0)
-        except ProcessLookupError:
-            return pid
-        except PermissionError:
-            pass
-        pid -= 1
 
 
 def test_a_dead_writers_strays_are_removed_when_the_run_starts_again(tmp_path):

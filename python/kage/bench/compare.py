@@ -33,7 +33,7 @@ from typing import Dict, List, NoReturn, Optional
 
 from kage.bench import intervals, plots, report, stats
 from kage.bench.interval_tables import explanation, fmt_drop, fmt_interval, intervals_csv
-from kage.util.files import atomic_write
+from kage.util.files import atomic_write, output_folder
 from kage.util.tables import SUCCESS_SHOWN, csv_text, md_table
 
 SCHEDULE_ARGS = ("total_timesteps", "eval_every_steps", "eval_episodes", "eval_num_envs", "eval_greedy")
@@ -229,7 +229,7 @@ def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optiona
 
 
 def write(out_dir: str, methods: List[Method], result: dict) -> None:
-    os.makedirs(os.path.join(out_dir, "plots"), exist_ok=True)
+    output_folder(out_dir, "plots")
     files = {"compare.md": markdown(methods, result["improvement"], result["protocol"]["score"]).encode(),
              "compare.csv": intervals_csv([r for m in methods for r in m.estimates["rows"]],
                                           [m.name for m in methods for _ in m.estimates["rows"]]).encode(),

@@ -70,7 +70,7 @@ from typing import Dict, List, NoReturn, Optional, Sequence, Tuple
 from kage.bench import intervals, plots
 from kage.bench.units import Unit, units_of
 from kage.bench.tables import METRICS, PROTOCOL_TEXTS, SUCCESS_SHOWN, write_tables
-from kage.util.files import atomic_write, safe
+from kage.util.files import atomic_write, output_folder, safe
 
 DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # as kage.ppo.train logs
 PROTOCOLS = ("max", "final")
@@ -447,7 +447,6 @@ def write_plots(out_dir: str, units: List[Unit], runs: Dict[str, List[Run]], lev
             f"{s['sweep']} ({s['axis']})", [e["sweep_eval"] for e in s["evals"]],
             [e["metrics"][SUCCESS_SHOWN]["eval"] for e in s["evals"]], s["evals"][0]["metrics"][SUCCESS_SHOWN]["train"],
             interim)
-    os.makedirs(os.path.join(out_dir, "plots"), exist_ok=True)
     for name, png in figures.items():
         atomic_write(os.path.join(out_dir, name), png)
     return sorted(figures)
@@ -507,7 +506,7 @@ def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
 
 def write_report(out_dir: str, result: dict, units: List[Unit], runs: Dict[str, List[Run]]) -> None:
     """The tables, the plots, then report.json (`result`, completed with the files written)."""
-    os.makedirs(out_dir, exist_ok=True)
+    output_folder(out_dir, "plots")
     files = write_tables(out_dir, result["suite"], result["levels"], result["runs_found"],
                          PROTOCOL_TEXTS[result["protocol"]["score"]], result["intervals"], result["protocol"]["score"])
     result["plots_note"] = None

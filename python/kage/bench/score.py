@@ -18,7 +18,7 @@ from kage.errors import ConfigError
 from kage.ppo import rundir
 from kage.ppo.evaluate import add_scoring_arguments, fail, load_for_scoring, open_env, result_of, settings_of
 from kage.ppo.evaluation import EvalTargets, evaluation_rows
-from kage.util.files import write_json
+from kage.util.files import output_folder, write_json
 
 PROTOCOL = ("One checkpoint, evaluated once on each side of each pair (the protocol of an evaluation point during "
             "training): a pair's values are that evaluation's (n = 1, SEM 0); per axis, the mean ± SEM of the "
@@ -60,7 +60,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser.add_argument("--out", required=True, help="where to write the tables (created)")
     options = parser.parse_args(argv)
     file, agent, spec, state = load_for_scoring(parser, options)
-    os.makedirs(options.out, exist_ok=True)
+    output_folder(options.out)
     header = f"checkpoint {file} (iteration {state['iteration']}, seed {options.seed})"
     result = dict(result_of(file, spec, state, options), **score_suite(agent, spec, file, state, options))
     files = tables.write_tables(options.out, f"{result['suite']}: {header}", result["levels"], result["status"],

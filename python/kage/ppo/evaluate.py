@@ -28,7 +28,7 @@ from kage.ppo.args import MAX_INT32
 from kage.errors import ConfigError
 from kage.util import tables
 from kage.ppo.evaluation import METRICS, EvalSettings, evaluate, evaluation_seed
-from kage.util.files import atomic_write, os_error_text, write_json
+from kage.util.files import atomic_write, os_error_text, output_folder, write_json
 
 CONFIG_COLUMNS = ("episodes", "return", "length", "success_once", "success", "passed_distance", "progress",
                   "jump_count", "x", "y", "vx_mean", "vy_mean")
@@ -236,7 +236,7 @@ def evaluate_command(argv: Optional[List[str]]) -> int:
         parser.error("--video-stride must be positive")
     file, agent, spec, state = load_for_scoring(parser, options)
     if options.out:
-        os.makedirs(options.out, exist_ok=True)
+        output_folder(options.out)
         header = f"checkpoint {file} (iteration {state['iteration']}, seed {options.seed})"
         result = dict(result_of(file, spec, state, options), configs=evaluate_configs(agent, spec, file, state, options))
         files = write_config_tables(options.out, result["configs"], header)

@@ -70,6 +70,14 @@ def create_temporary(path: str):
     raise FileExistsError(errno.EEXIST, "no unused temporary name after 100 tries", path)
 
 
+def output_folder(path: str, *subfolders: str) -> None:
+    """Creates `path` and its `subfolders` for files replaced whole (a report's, a scoring's), removing the
+    temporary files that killed writers left there."""
+    for folder in (path, *(os.path.join(path, sub) for sub in subfolders)):
+        os.makedirs(folder, exist_ok=True)
+        remove_strays(folder)
+
+
 def remove_strays(directory: str) -> None:
     """Removes the temporary files of atomic_write in `directory` whose writer is gone: this host's whose
     process no longer runs, and any older than STRAY_AGE_S. Live writers' files are left alone."""
