@@ -98,6 +98,15 @@ def test_another_hosts_lock_holds_while_its_heartbeat_is_fresh(tmp_path):
         lock.DirectoryLock(str(tmp_path), "run", "test").acquire("use another --out")
 
 
+@pytest.mark.parametrize("content", ["not json", "[]", '{"pid": "x"}', '{"host": "elsewhere"}'])
+def test_a_lock_that_names_no_writer_says_so_and_how_to_clear_it(tmp_path, content):
+    (tmp_path / "run.lock").write_text(content)
+    with pytest.raises(lock.LockHeld) as held:
+        lock.DirectoryLock(str(tmp_path), "run", "test").acquire("use another --out")
+    assert f"has a lock that names no writer ({tmp_path / 'run.lock'}" in str(held.value)
+    assert "delete it if no process uses" in str(held.value) and "?" not in str(held.value)
+
+
 def test_another_hosts_lock_with_an_old_heartbeat_is_taken_over(tmp_path):
     plant(tmp_path, {"host": "elsewhere", "pid": 77, "token": "x"}, age_s=lock.STALE_S + 60)
     held = lock.DirectoryLock(str(tmp_path), "run", "test")

@@ -115,6 +115,11 @@ class DirectoryLock:
 
     def describe(self, holder: dict, way_out: str) -> str:
         age = self._heartbeat_age()
+        if not isinstance(holder.get("pid"), int) or not isinstance(holder.get("host"), str):
+            # Not a lock this program wrote (damaged, or made by hand): nobody can be named as its holder.
+            return (f"{self.directory} has a lock that names no writer ({self.path}, changed {age:,.0f} s ago): "
+                    f"delete it if no process uses {self.directory}, or wait {STALE_S:.0f} s from its last change, "
+                    f"after which it is taken over; or use another directory.")
         return (f"{self.directory} is in use by another writer: process {holder.get('pid', '?')} on host "
                 f"{holder.get('host', '?')}, since {holder.get('started', '?')} ({holder.get('program', '?')}; lock "
                 f"{self.path}, heartbeat {age:,.0f} s ago). {way_out}. A holder on another host that stopped without "
