@@ -43,7 +43,7 @@ from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
 from kage.bench.units import Unit, select, units_of
 from kage.errors import ConfigError
-from kage.util.files import atomic_write, os_error_text, remove_strays, write_json
+from kage.util.files import atomic_write, os_error_text, read_json_record, remove_strays, write_json
 from kage.util.lock import DirectoryLock, LockHeld
 from kage.util.stop import child_environment, die_with_parent, stop_children
 
@@ -144,12 +144,7 @@ def suite_problem(suite) -> Optional[str]:
 
 def read_record(path: str, problem_of) -> dict:
     """bench.json or suite.json of DIR, refused in one line where it is damaged."""
-    try:
-        with open(path) as f:
-            value = json.load(f)
-        problem = problem_of(value)
-    except ValueError as e:
-        problem = f"not JSON ({e})"
+    value, problem = read_json_record(path, problem_of)
     if problem:
         raise SystemExit(f"kage.bench: {path} is damaged ({problem}): restore it, or delete it and run the same "
                          "command again to write it anew (or use another --out)")

@@ -37,7 +37,7 @@ import torch
 from kage import front_end, resources
 from kage.errors import ConfigError
 from kage.ppo import checkpoint, plugins
-from kage.util.files import atomic_write, named_errors, remove_strays, safe, write_json
+from kage.util.files import atomic_write, named_errors, read_json_record, remove_strays, safe, write_json
 from kage.util.lock import DirectoryLock, LockHeld
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
@@ -272,12 +272,7 @@ def check_finished(path: str, args, configs: List[Tuple[str, str]]) -> None:
 
 def read_run_json(path: str) -> dict:
     """A run's run.json, refused by name where it is not JSON or lacks what a run records."""
-    try:
-        with open(path) as f:
-            run = json.load(f)
-        problem = run_json_problem(run)
-    except ValueError as e:
-        problem = f"not JSON ({e})"
+    run, problem = read_json_record(path, run_json_problem)
     if problem:
         raise SystemExit(f"kage.ppo.train: {path}: {problem}: restore it from a copy, or train anew with another --out")
     return run

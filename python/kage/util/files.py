@@ -14,6 +14,7 @@ import re
 import secrets
 import socket
 import time
+from typing import Any, Callable, Optional, Tuple
 
 STRAY_AGE_S = 3600  # another host's temporary file this old is a dead writer's: a write takes seconds
 _TEMPORARY = re.compile(r"^.+\.tmp\.(?P<host>[^/]+?)\.(?P<pid>\d+)(?:\.[0-9a-f]+)?$")
@@ -115,6 +116,17 @@ def process_alive(pid: int) -> bool:
     except PermissionError:
         return True
     return True
+
+
+def read_json_record(path: str, problem_of: Callable[[Any], Optional[str]]) -> Tuple[Any, Optional[str]]:
+    """A JSON record's value and what is wrong with it (not JSON, or `problem_of`'s answer; None when nothing is),
+    for the caller to refuse in its own words. OSError passes through."""
+    with open(path) as f:
+        try:
+            value = json.load(f)
+        except ValueError as e:  # UnicodeDecodeError too
+            return None, f"not JSON ({e})"
+    return value, problem_of(value)
 
 
 def write_json(path: str, value) -> None:
