@@ -1,6 +1,7 @@
 """kage.ppo.fast.triton_conv's packed convolutions (Triton implicit-GEMM kernels, the run as a grid axis) against
 cuDNN's grouped convolutions, forward and the input, weight and bias gradients, for the NatureCNN's three layers
-(alone and with the fused ReLU) at K = 3 and 8 packed runs, in fp32 and bf16. The fp32 checks allow 1e-3: tl.dot
+(alone and with the fused ReLU) at K = 3 and 8 packed runs, in fp32 and bf16; and conv1 as the trainer runs it,
+striding over uint8 frames in a rollout buffer at a minibatch's indices (output, weight and bias gradients). The fp32 checks allow 1e-3: tl.dot
 rounds fp32 operands to TF32 (10-bit mantissa). The bf16 checks allow 2e-2 (outputs rounded to bf16). Errors are max |got - want| / max |want|.
 `python3 tests/gpu/test_triton_conv.py [--profile]` also times the torso against cuDNN channels-last bf16."""
 import argparse
@@ -64,13 +65,49 @@ def check_layer(k: int, b: int, layer, dtype: torch.dtype, tolerance: float, rel
     return failures
 
 
+def check_conv1_frames(k: int, b: int, dtype: torch.dtype, tolerance: float) -> int:
+    """conv1 + ReLU from uint8 frames where a [T = 2, K, B] rollout buffer holds them, at shuffled minibatch
+    indices (packed_conv_frames), against F.conv2d(groups=K) in fp32 on the gathered frames / 255 rounded to
+    `dtype` (as the trainer's other paths convert them); prints one line per quantity, returns the failures."""
+    torch.manual_seed(1)
+    buffer = torch.randint(0, 256, (2, k, b, 128, 128, 3), dtype=torch.uint8, device="cuda")
+    batch = torch.stack([torch.randperm(2 * b, device="cuda")[:b] for _ in range(k)])  # each run's minibatch
+    runs = torch.arange(k, device="cuda")[:, None]
+    images = (batch // b * k + runs) * b + batch % b
+    conv = torch.nn.Conv2d(k * 3, k * 32, 8, 4, groups=k, device="cuda")
+    weight, bias = conv.weight.detach().requires_grad_(), conv.bias.detach().uniform_(-0.5, 0.5).requires_grad_()
+    y = tc.packed_conv_frames(buffer, images, weight, bias, 4, dtype, relu=True)
+    dy = torch.randn_like(y)
+    got = (y,) + torch.autograd.grad(y, (weight, bias), dy)
+
+    frames = buffer.transpose(0, 1).reshape(k, 2 * b, 128, 128, 3)[runs, batch]
+    x_ref = frames.to(dtype).div_(255.0).float().permute(1, 0, 4, 2, 3).reshape(b, k * 3, 128, 128)
+    w_ref = weight.detach().to(dtype).float().requires_grad_()
+    b_ref = bias.detach().clone().requires_grad_()
+    y_ref = F.conv2d(x_ref, w_ref, b_ref, stride=4, groups=k)
+    positive = (y.detach() > 0).float().permute(1, 0, 4, 2, 3).reshape(y_ref.shape)  # as in check_layer
+    dw_ref, db_ref = torch.autograd.grad(y_ref, (w_ref, b_ref), dy.float().permute(1, 0, 4, 2, 3).reshape(
+        y_ref.shape) * positive)
+    want = (F.relu(y_ref).reshape(b, k, 32, 31, 31).permute(1, 0, 3, 4, 2), dw_ref, db_ref)
+    failures = 0
+    for quantity, g, r in zip(("y", "dw", "db"), got, want):
+        error = relative_error(g, r)
+        ok = error <= tolerance and g.dtype == (dtype if quantity == "y" else torch.float32)
+        failures += not ok
+        print(f"K = {k}, B = {b}, {str(dtype)[6:]}, conv1 + ReLU from frames {quantity}: max relative error "
+              f"{error:.2e} (tolerance {tolerance:.0e}, {str(g.dtype)[6:]}) {'PASS' if ok else 'FAIL'}", flush=True)
+    return failures
+
+
 def torso_steps(k: int, b: int):
     """Forward + backward (a sum loss) of K NatureCNN torsos on B frames each under bf16 autocast with fp32
-    weights, conv1 on the 4 x 4 space-to-depth frames (the trainer's fused input): the Triton kernels, and
-    cuDNN's grouped convolutions in channels-last as the trainer runs them with all speed flags."""
+    weights: the Triton kernels as --triton-conv runs them (conv1 on the uint8 frames), and cuDNN's grouped
+    convolutions in channels-last on the 4 x 4 space-to-depth frames (--fused-input), as the trainer runs them
+    with all speed flags but --triton-conv."""
     convs = [torch.nn.Conv2d(k * cin, k * cout, ksize, stride, groups=k, device="cuda")
              for _, _, cin, cout, ksize, stride in LAYERS]
-    frames = torch.rand(k, b, 32, 32, 48, device="cuda").to(torch.bfloat16)
+    frames = torch.randint(0, 256, (k, b, 128, 128, 3), dtype=torch.uint8, device="cuda")
+    images = torch.arange(k * b, device="cuda").view(k, b)
     cl_convs = [torch.nn.Conv2d(c.in_channels, c.out_channels, c.kernel_size, c.stride, groups=k, device="cuda")
                 .to(memory_format=torch.channels_last) for c in convs]
     cl_frames = torch.rand(b, k * 48, 32, 32, device="cuda").to(torch.bfloat16).contiguous(
@@ -78,7 +115,7 @@ def torso_steps(k: int, b: int):
 
     def triton_step():
         with torch.autocast("cuda", dtype=torch.bfloat16):
-            x = tc.packed_conv(frames, s2d.weight_space_to_depth(convs[0].weight, 4), convs[0].bias, relu=True)
+            x = tc.packed_conv_frames(frames, images, convs[0].weight, convs[0].bias, 4, torch.bfloat16, relu=True)
             x = tc.packed_conv(x, convs[1].weight, convs[1].bias, 2, relu=True)
             x = tc.packed_conv(x, convs[2].weight, convs[2].bias, relu=True)
             loss = x.sum()
@@ -135,6 +172,14 @@ def test_packed_conv_equals_grouped_conv(k, b, dtype, tolerance, layer, relu):
     torch.cuda.empty_cache()
 
 
+@pytest.mark.parametrize("k, b", [(3, 64), (8, 2048)])
+@pytest.mark.parametrize("dtype, tolerance", [(torch.float32, 1e-3), (torch.bfloat16, 2e-2)])
+def test_conv1_from_frames_equals_grouped_conv(k, b, dtype, tolerance):
+    full_fp32_references()
+    assert check_conv1_frames(k, b, dtype, tolerance) == 0
+    torch.cuda.empty_cache()
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--profile", action="store_true", help="print the top CUDA kernels of one torso step of each")
@@ -151,6 +196,7 @@ def main() -> None:
                 for relu in (False, True):
                     failures += check_layer(k, b, layer, dtype, tolerance, relu)
                     torch.cuda.empty_cache()
+            failures += check_conv1_frames(k, b, dtype, tolerance)
 
     k, b = 8, 2048
     triton_step, cudnn_step = torso_steps(k, b)

@@ -1,6 +1,6 @@
 """kage.ppo.fast.triton_conv's kernels compiled for the H100 (sm_90) as the trainer runs them, in bfloat16, on a
 machine without a GPU: Triton's own compiler and the ptxas it ships, every autotuning config of every kernel, at
-each NatureCNN layer's shapes (after space-to-depth), the fused ReLU in and out. The interpreter
+each NatureCNN layer's shapes (conv1 on the uint8 frames, conv2 after space-to-depth), the fused ReLU in and out. The interpreter
 (test_triton_interpreter.py) checks the values in float32 but never types bf16 code; this catches what only the
 compiler sees (dtype mismatches in tl.dot and tl.where, unsupported tile shapes) before a GPU lease is spent on it.
 The values in bf16 are checked on the GPU (tests/gpu/test_triton_conv.py)."""
@@ -12,15 +12,18 @@ from triton.compiler import ASTSource
 from kage.ppo.fast import triton_conv as tc
 
 H100 = GPUTarget("cuda", 90, 32)
-# (name, H, W, Cin, Cout, kh, kw) of the stride-1 convolutions the kernels run: conv1 on 4x4 blocks of the
+# (name, H, W, Cin, Cout, kh, kw, stride) of the convolutions the kernels run: conv1 striding over the uint8
 # 128 x 128 x 3 frames, conv2 on 2x2 blocks of conv1's 31 x 31 x 32 output, conv3 as it is.
-LAYERS = [("conv1", 32, 32, 48, 32, 2, 2), ("conv2", 15, 15, 128, 64, 2, 2), ("conv3", 14, 14, 64, 64, 3, 3)]
-# Each kernel's pointer and run-time integer arguments, as _forward, _dgrad and _wgrad pass them under --bf16.
+LAYERS = [("conv1", 128, 128, 3, 32, 8, 8, 4), ("conv2", 15, 15, 128, 64, 2, 2, 1),
+          ("conv3", 14, 14, 64, 64, 3, 3, 1)]
+# Each kernel's pointer and run-time integer arguments, as _forward, _dgrad and _wgrad pass them under --bf16 on
+# activations; conv1's x is uint8 frames read at int64 image indices.
 SIGNATURES = {
-    tc.forward_kernel: {"x_ptr": "*bf16", "w_ptr": "*bf16", "bias_ptr": "*fp32", "y_ptr": "*bf16", "B": "i32"},
+    tc.forward_kernel: {"x_ptr": "*bf16", "images_ptr": "*i64", "w_ptr": "*bf16", "bias_ptr": "*fp32",
+                        "y_ptr": "*bf16", "B": "i32"},
     tc.dgrad_kernel: {"dy_ptr": "*bf16", "y_ptr": "*bf16", "w_ptr": "*bf16", "dx_ptr": "*bf16", "B": "i32"},
-    tc.wgrad_kernel: {"x_ptr": "*bf16", "dy_ptr": "*bf16", "y_ptr": "*bf16", "parts_ptr": "*fp32",
-                      "bias_parts_ptr": "*fp32", "B": "i32", "CHUNK": "i32", "SPLIT": "i32"},
+    tc.wgrad_kernel: {"x_ptr": "*bf16", "images_ptr": "*i64", "dy_ptr": "*bf16", "y_ptr": "*bf16",
+                      "parts_ptr": "*fp32", "bias_parts_ptr": "*fp32", "B": "i32", "CHUNK": "i32", "SPLIT": "i32"},
 }
 NAMES = {tc.forward_kernel: "forward_kernel", tc.dgrad_kernel: "dgrad_kernel", tc.wgrad_kernel: "wgrad_kernel"}
 
@@ -28,7 +31,12 @@ NAMES = {tc.forward_kernel: "forward_kernel", tc.dgrad_kernel: "dgrad_kernel", t
 def compile_for_h100(kernel, config: triton.Config, constants: dict):
     """`kernel`'s cubin for sm_90 under one autotuning config and the given compile-time constants."""
     fn = kernel.fn
-    types = SIGNATURES[kernel]
+    types = dict(SIGNATURES[kernel])
+    if constants.get("FRAMES"):
+        types["x_ptr"] = "*u8"
+    elif "images_ptr" in types:  # activations: _forward and _wgrad pass images=None, which Triton makes a constant
+        del types["images_ptr"]
+        constants = dict(constants, images_ptr=None)
     constants = {**constants, **config.kwargs}
     source = ASTSource(fn=fn, signature={name: types.get(name, "constexpr") for name in fn.arg_names},
                        constexprs={(fn.arg_names.index(name),): value for name, value in constants.items()})
@@ -44,10 +52,11 @@ CASES = [(kernel, layer, index) for kernel in SIGNATURES for layer in LAYERS
 @pytest.mark.parametrize("kernel, layer, index", CASES,
                          ids=[f"{NAMES[k]}-{layer[0]}-config{i}" for k, layer, i in CASES])
 def test_kernel_compiles_for_the_h100_in_bf16(kernel, layer, index):
-    _, h, w, cin, cout, kh, kw = layer
-    constants = dict(H=h, W=w, OH=h - kh + 1, OW=w - kw + 1, CIN=cin, COUT=cout, KH=kh, KW=kw)
+    name, h, w, cin, cout, kh, kw, stride = layer
+    constants = dict(H=h, W=w, OH=(h - kh) // stride + 1, OW=(w - kw) // stride + 1, CIN=cin, COUT=cout, KH=kh,
+                     KW=kw)
     if kernel is not tc.dgrad_kernel:  # their tiles span the whole output width (triton_conv._width_block)
-        constants["BLOCK_N"] = tc._width_block(cout)
+        constants.update(BLOCK_N=tc._width_block(cout), STRIDE=stride, FRAMES=name == "conv1")
     # The fused ReLU under every config (the trainer's path); without it under the first.
     for relu in (True, False) if index == 0 else (True,):
         compiled = compile_for_h100(kernel, kernel.configs[index], dict(constants, RELU=relu))

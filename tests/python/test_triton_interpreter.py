@@ -1,9 +1,13 @@
 """kage.ppo.fast.triton_conv's kernels (--triton-conv) on the CPU under Triton's interpreter, in float32, against
-torch's grouped convolutions (F.conv2d(groups=K), the plain layers) on the same values: the output and the input,
-weight and bias gradients of the NatureCNN's three layers as the trainer runs them (conv1 as the 2x2 stride-1
-convolution of 4x4 blocks, 48 channels; conv2 as the 2x2 one of 2x2 blocks, 128 channels; conv3 3x3), alone and
-with the fused ReLU, under each autotuning config of every kernel, K = 2 runs of B = 2 or 3 frames; the weight
-and bias gradients' split into partial sums; and the Agent's --triton-conv torso against its plain one, forward and parameter gradients.
+torch's grouped convolutions (F.conv2d(groups=K), the plain layers) on the same values, the NatureCNN's layers as
+the trainer runs them, under each autotuning config of every kernel, K = 2 runs of B = 2 or 3 frames:
+- conv1 striding over uint8 frames where a rollout buffer holds them (a minibatch's shuffled indices), output
+  and weight and bias gradients;
+- conv2 (the 2x2 stride-1 convolution of 2x2 blocks, 128 channels) and conv3 (3x3), output and input, weight
+  and bias gradients, alone and with the fused ReLU;
+- the weight and bias gradients' split into partial sums;
+- the Agent's --triton-conv torso against its plain one, forward and parameter gradients, on a batch and on a
+  minibatch read from a rollout buffer.
 
 The interpreter computes tl.dot in full float32 (no TF32), so the kernels must agree with torch to float32
 rounding. bfloat16 is checked on the GPU only (tests/gpu/test_triton_conv.py): the interpreter does not emulate
@@ -24,11 +28,11 @@ from triton.runtime.interpreter import InterpretedFunction  # noqa: E402
 
 from kage.ppo.agent import Agent  # noqa: E402
 from kage.ppo.fast import triton_conv as tc  # noqa: E402
-from kage.ppo.fast.space_to_depth import space_to_depth, weight_space_to_depth  # noqa: E402
 
 KERNELS = (tc.forward_kernel, tc.dgrad_kernel, tc.wgrad_kernel)
-# NatureCNN's convolutions on 128 x 128 x 3 frames: (name, input side, in channels, out channels, kernel, stride).
-LAYERS = [("conv1", 128, 3, 32, 8, 4), ("conv2", 31, 32, 64, 4, 2), ("conv3", 14, 64, 64, 3, 1)]
+# NatureCNN's convolutions after conv1 (which reads the frames: test_conv1_reads_frames_in_place): (name, input
+# side, in channels, out channels, kernel, stride).
+LAYERS = [("conv2", 31, 32, 64, 4, 2), ("conv3", 14, 64, 64, 3, 1)]
 # max |got - want| / max |want|: float32 rounding of sums over up to 1,024 products, in another order.
 TOLERANCE = 1e-5
 
@@ -41,24 +45,16 @@ def interpreted():
 
 
 def use_config(index: int, monkeypatch) -> None:
-    """Each kernel restricted to its index-th autotuning config: with one config the autotuner runs it without
-    benchmarking (which needs a GPU driver), and each config's tile sizes meet the masks differently."""
+    """Each kernel restricted to its index-th autotuning config (its last where it has fewer): with one config
+    the autotuner runs it without benchmarking (which needs a GPU driver), and each config's tile sizes meet the
+    masks differently."""
     for kernel in KERNELS:
-        monkeypatch.setattr(kernel, "configs", [kernel.configs[index]])
+        monkeypatch.setattr(kernel, "configs", [kernel.configs[min(index, len(kernel.configs) - 1)]])
 
 
 def relative_error(got: torch.Tensor, want: torch.Tensor) -> float:
     assert got.shape == want.shape, (got.shape, want.shape)
     return ((got.double() - want.double()).abs().max() / want.double().abs().max()).item()
-
-
-def packed_layer(name: str, x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int,
-                 relu: bool) -> torch.Tensor:
-    """One layer as Agent._torso_triton runs it: conv1 on the frames' 4x4 blocks, conv2 through packed_conv's
-    2x2 blocks, conv3 as it is; the ReLU fused in under `relu`."""
-    if name == "conv1":
-        return tc.packed_conv(space_to_depth(x, 4), weight_space_to_depth(weight, 4), bias, relu=relu)
-    return tc.packed_conv(x, weight, bias, stride, relu=relu)
 
 
 def grouped_layer(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int) -> torch.Tensor:
@@ -85,7 +81,7 @@ def test_layer_equals_grouped_conv(layer, config, relu, monkeypatch):
     weight = torch.randn(k * cout, cin, ksize, ksize, generator=generator, requires_grad=True)
     bias = torch.randn(k * cout, generator=generator, requires_grad=True)
 
-    y = packed_layer(name, x, weight, bias, stride, relu)
+    y = tc.packed_conv(x, weight, bias, stride, relu=relu)
     dy = torch.randn(y.shape, generator=generator)
     got = (y,) + torch.autograd.grad(y, (x, weight, bias), dy)
     y_ref = grouped_layer(x, weight, bias, stride)
@@ -97,6 +93,33 @@ def test_layer_equals_grouped_conv(layer, config, relu, monkeypatch):
     for quantity, g, w in zip(("y", "dx", "dw", "db"), got, want):
         assert g.dtype == torch.float32, quantity
         assert relative_error(g, w) <= TOLERANCE, (name, quantity, relative_error(g, w))
+
+
+@pytest.mark.parametrize("config", range(len(tc.wgrad_kernel.configs)))
+def test_conv1_reads_frames_in_place(config, monkeypatch):
+    """conv1 (8x8, stride 4, ReLU) as the trainer's update runs it: uint8 frames read where a [T, K, N] rollout
+    buffer holds them, at a minibatch's shuffled indices, scaled by 1 / 255 as they are read. The output and
+    the weight and bias gradients equal the plain layer's on the gathered frames / 255."""
+    use_config(config, monkeypatch)
+    steps, k, envs, side, cout = 2, 2, 3, 128, 32
+    generator = torch.Generator().manual_seed(config)
+    buffer = torch.randint(0, 256, (steps, k, envs, side, side, 3), dtype=torch.uint8, generator=generator)
+    # Run k's j-th minibatch element is element t * N + n of its batch: frame (t * K + k) * N + n of the buffer.
+    batch = torch.stack([torch.randperm(steps * envs, generator=generator)[:2] for _ in range(k)])  # [K, B]
+    images = (batch // envs * k + torch.arange(k)[:, None]) * envs + batch % envs
+    weight = (0.1 * torch.randn(k * cout, 3, 8, 8, generator=generator)).requires_grad_()
+    bias = torch.randn(k * cout, generator=generator, requires_grad=True)
+
+    y = tc.packed_conv_frames(buffer, images, weight, bias, 4, torch.float32, relu=True)
+    dy = torch.randn(y.shape, generator=generator)
+    got = (y,) + torch.autograd.grad(y, (weight, bias), dy)
+    gathered = buffer.transpose(0, 1).reshape(k, steps * envs, side, side, 3)[torch.arange(k)[:, None], batch]
+    y_ref = F.relu(grouped_layer(gathered.float() / 255, weight, bias, 4))
+    assert 0.2 < (y_ref > 0).double().mean() < 0.8, "both sides of the ReLU are exercised"
+    want = (y_ref,) + torch.autograd.grad(y_ref, (weight, bias), dy)
+    for quantity, g, w in zip(("y", "dw", "db"), got, want):
+        assert g.dtype == torch.float32, quantity
+        assert relative_error(g, w) <= TOLERANCE, (quantity, relative_error(g, w))
 
 
 @pytest.mark.parametrize("chunk", [100, 128])
@@ -117,7 +140,7 @@ def test_weight_gradient_partial_sums(chunk, monkeypatch):
     dy = torch.randn(y.shape, generator=generator)
     dw_ref, db_ref = torch.autograd.grad(y, (weight, bias), dy)
 
-    dw, db = tc._wgrad(x, dy, y.detach().contiguous(), ksize, ksize, relu=True)  # [K, kh, kw, Cin, Cout], [K, Cout]
+    dw, db = tc._wgrad(x, None, dy, y.detach().contiguous(), ksize, ksize, 1, relu=True)  # [K, kh, kw, Cin, Cout], [K, Cout]
     assert relative_error(dw, dw_ref.reshape(k, cout, cin, ksize, ksize).permute(0, 3, 4, 2, 1)) <= TOLERANCE
     assert relative_error(db, db_ref.reshape(k, cout)) <= TOLERANCE
 
@@ -138,13 +161,19 @@ def test_agent_triton_torso_equals_plain(monkeypatch):
     obs = torch.randint(0, 256, (len(seeds), frames, side, side, 3), dtype=torch.uint8, generator=generator)
     weights = torch.randn(len(seeds), frames, 8, generator=generator)
 
+    # The same frames as a minibatch of a rollout buffer [T = 2, K, N = 2]: run k's b-th frame at images[k, b].
+    buffer = torch.randint(0, 256, (2, len(seeds), 2, side, side, 3), dtype=torch.uint8, generator=generator)
+    images = torch.tensor([[6, 1, 4], [3, 7, 2]])
+    buffer.view(-1, side, side, 3)[images] = obs
+
     results = []
-    for agent in (plain, fast):
-        logits, value = agent(obs)
+    for agent, inputs in ((plain, (obs,)), (fast, (obs,)), (plain, (buffer, images)), (fast, (buffer, images))):
+        logits, value = agent(*inputs)
         loss = (logits * weights).sum() + value.square().sum()  # every output reaches the gradients
         results.append((logits, value, torch.autograd.grad(loss, list(agent.parameters()))))
-    (logits, value, grads), (fast_logits, fast_value, fast_grads) = results
-    assert relative_error(fast_logits, logits) <= TOLERANCE
-    assert relative_error(fast_value, value) <= TOLERANCE
-    for (name, _), g, fast_g in zip(plain.named_parameters(), grads, fast_grads):
-        assert relative_error(fast_g, g) <= TOLERANCE, (name, relative_error(fast_g, g))
+    logits, value, grads = results[0]
+    for fast_logits, fast_value, fast_grads in results[1:]:
+        assert relative_error(fast_logits, logits) <= TOLERANCE
+        assert relative_error(fast_value, value) <= TOLERANCE
+        for (name, _), g, fast_g in zip(plain.named_parameters(), grads, fast_grads):
+            assert relative_error(fast_g, g) <= TOLERANCE, (name, relative_error(fast_g, g))

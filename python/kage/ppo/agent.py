@@ -2,13 +2,13 @@
 (K = 1 for a lone run): each run owns one group of every grouped convolution and one matrix of every
 batched linear layer, so one pass per layer evaluates all K."""
 import math
-from typing import List
+from typing import List, Optional
 
 import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-from kage.ppo.fast.space_to_depth import space_to_depth, weight_space_to_depth
+from kage.ppo.fast.space_to_depth import weight_space_to_depth
 
 
 def orthogonal(out_features: int, in_features: int, gain: float, device) -> torch.Tensor:
@@ -18,10 +18,18 @@ def orthogonal(out_features: int, in_features: int, gain: float, device) -> torc
     return weight
 
 
+def frames_at(frames: torch.Tensor, images: Optional[torch.Tensor]) -> torch.Tensor:
+    """uint8 frames [..., H, W, C] at int64 images [K, B] -> [K, B, H, W, C] (frames as they are without images)."""
+    return frames if images is None else frames.reshape(-1, *frames.shape[-3:])[images]
+
+
 class Agent(nn.Module):
     """K agents (a pack; K = 1 for a lone run): NatureCNN torsos without padding, a 512-unit layer and two
     linear heads each (§1.2). Run k owns the k-th group of every grouped convolution and the k-th matrix of
     every batched linear layer, so one pass per layer evaluates all K."""
+
+    # forward(frames, images) reads a minibatch where the rollout stored it (kage.ppo.plugins).
+    takes_frame_indices = True
 
     def __init__(self, seeds: List[int], channels: int = 3, height: int = 128, width: int = 128, device="cpu",
                  num_actions: int = 8, *, bf16: bool = False, channels_last: bool = False, fused_input: bool = False,
@@ -64,11 +72,12 @@ class Agent(nn.Module):
         for weight, gain in ((self.fc_weight, math.sqrt(2)), (self.actor_weight, 0.01), (self.critic_weight, 1.0)):
             weight[run].copy_(orthogonal(weight.shape[2], weight.shape[1], gain, weight.device).T)
 
-    def forward(self, obs: torch.Tensor):
-        """uint8 [K, B, H, W, C] frames -> logits [K, B, A] and values [K, B]. The first operation is the
-        conversion to float32 divided by 255 (§1.1); the runs' frames meet as channel groups (under --triton-conv
-        as a batch index)."""
-        hidden = F.relu(torch.baddbmm(self.fc_bias, self._torso(obs), self.fc_weight))
+    def forward(self, obs: torch.Tensor, images: Optional[torch.Tensor] = None):
+        """uint8 [K, B, H, W, C] frames -> logits [K, B, A] and values [K, B]; with int64 images [K, B], run k's
+        b-th frame is obs.reshape(-1, H, W, C)[images[k, b]] (a minibatch of the rollout buffer: --triton-conv
+        reads it there, the other torsos gather it). The first operation is the conversion to float32 divided
+        by 255 (§1.1); the runs' frames meet as channel groups (under --triton-conv as a batch index)."""
+        hidden = F.relu(torch.baddbmm(self.fc_bias, self._torso(obs, images), self.fc_weight))
         # The heads always in float32, even under --bf16: values reach thousands (an untrained episode
         # returns about -3,900), where bfloat16's spacing is 16, more than a step's reward; rounded values
         # would bury the advantages in noise.
@@ -78,14 +87,16 @@ class Agent(nn.Module):
             value = torch.baddbmm(self.critic_bias, hidden, self.critic_weight).squeeze(-1)
         return logits, value
 
-    def _torso_frames(self, obs: torch.Tensor) -> torch.Tensor:
+    def _torso_frames(self, obs: torch.Tensor, images: Optional[torch.Tensor]) -> torch.Tensor:
         """The three convolutions on the frames, the runs as channel groups: [K, B, H, W, C] -> [K, B, flat]."""
+        obs = frames_at(obs, images)
         k, b, h, w, c = obs.shape
         x = F.relu(self.conv1(self._input(obs.permute(1, 2, 3, 0, 4).reshape(b, h, w, k * c))))
         return self._conv2_conv3(x, k, b)
 
-    def _torso_blocks(self, obs: torch.Tensor) -> torch.Tensor:
+    def _torso_blocks(self, obs: torch.Tensor, images: Optional[torch.Tensor]) -> torch.Tensor:
         """As _torso_frames, conv1 on the frames cut into 4x4 blocks (--fused-input)."""
+        obs = frames_at(obs, images)
         k, b = obs.shape[:2]
         return self._conv2_conv3(F.relu(self._conv1_space_to_depth(obs)), k, b)
 
@@ -117,14 +128,17 @@ class Agent(nn.Module):
             weight = weight.contiguous(memory_format=torch.channels_last)
         return F.conv2d(x, weight, self.conv1.bias, stride=1, groups=k)
 
-    def _torso_triton(self, obs: torch.Tensor) -> torch.Tensor:
+    def _torso_triton(self, obs: torch.Tensor, images: Optional[torch.Tensor]) -> torch.Tensor:
         """The three convolutions on kage.ppo.fast.triton_conv's kernels (--triton-conv): the runs as a batch index
-        instead of channel groups, activations [K, B, H, W, C], the same parameters; conv1 on the frames cut
-        into 4x4 blocks as under --fused-input. Returns [K, B, flat] in each run's (channel, row, column) order."""
+        instead of channel groups, activations [K, B, H, W, C], the same parameters; conv1 strides over the
+        uint8 frames where they lie (scaled by 1 / 255 as it reads them). Returns [K, B, flat] in each run's
+        (channel, row, column) order."""
         from kage.ppo.fast import triton_conv  # here, not at the top: triton is needed only under the flag
-        k, b = obs.shape[:2]
-        x = space_to_depth(obs, 4, self.input_dtype).div_(255.0)
-        x = triton_conv.packed_conv(x, weight_space_to_depth(self.conv1.weight, 4), self.conv1.bias, relu=True)
+        if images is None:
+            images = torch.arange(obs.shape[0] * obs.shape[1], device=obs.device).view(obs.shape[:2])
+        k, b = images.shape
+        x = triton_conv.packed_conv_frames(obs, images, self.conv1.weight, self.conv1.bias, 4, self.input_dtype,
+                                           relu=True)
         x = triton_conv.packed_conv(x, self.conv2.weight, self.conv2.bias, stride=2, relu=True)
         x = triton_conv.packed_conv(x, self.conv3.weight, self.conv3.bias, relu=True)
         return x.permute(0, 1, 4, 2, 3).reshape(k, b, self.flat)

@@ -6,6 +6,9 @@ being (H, W, C) of uint8 frames (C = 12 under --use-frame-stack), and returns a 
 - a packable factory (`factory.packable = True`, as kage.ppo.agent.nature_cnn) gets the seeds of the K runs of
   a pack and returns one network for all of them: forward(uint8 [K, B, H, W, C]) -> (logits [K, B, A],
   values [K, B]), and run_view(tensor) splitting a parameter-shaped tensor into [K, ...] (each run's part);
+  one that sets `takes_frame_indices = True` (as kage.ppo.agent.Agent) is also called as forward(frames,
+  images) on update minibatches: run k's b-th frame is frames.reshape(-1, H, W, C)[images[k, b]], frames
+  being the rollout buffer, so it may read them there instead of in a gathered copy;
 - any other factory gets one seed and returns a plain network: forward(uint8 [B, H, W, C]) -> (logits
   [B, A], values [B]). Its runs train one at a time (kage.bench run --pack falls back to lone runs).
 The global torch seed is the run's seed when the factory is called, so its initialisation is reproducible.

@@ -42,6 +42,7 @@ import torch
 
 import kage
 from kage.ppo import checkpoint, plugins, rundir, tensorboard_log, video
+from kage.ppo.agent import frames_at
 from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args
 from kage.ppo.counter_random import CounterRandom
 from kage.ppo.evaluation import METRICS, EpisodeMetrics, EvalSettings, EvalTargets, evaluation_rows
@@ -83,6 +84,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     agent = plugins.build_agent(args.agent, (height, width, channels), num_actions, [a.seed for a in pack], device,
                                 speed_modes(args))  # §2.4: the runs' seeds
     augment = plugins.load_augment(args.augment)
+    # A network that reads a minibatch where the rollout stored it (kage.ppo.agent.Agent) gets the buffer and
+    # the frames' indices; any other gets the gathered frames.
+    frames_in_place = getattr(agent, "takes_frame_indices", False)
     for run in runs:
         open_run_dir(run)
     agent_spec = {"agent": args.agent, "observation_shape": [height, width, channels], "num_actions": num_actions,
@@ -180,8 +184,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
             advantages, returns = compute_gae(rewards, values, dones, next_value, state.next_done, args.gamma,
                                               args.gae_lambda)
 
-        # §2.5 step 4: E epochs of M minibatches over each run's flattened (time-major) batch.
-        b_obs = obs.transpose(0, 1).reshape(K, T * N, height, width, channels)
+        # §2.5 step 4: E epochs of M minibatches over each run's flattened (time-major) batch. Element t * N + n
+        # of run k is frame (t * K + k) * N + n of the rollout buffer: the minibatch's frames are read there.
         b_logprobs, b_actions, b_advantages, b_returns, b_values = (
             t.transpose(0, 1).reshape(K, T * N) for t in (logprobs, actions, advantages, returns, values))
         runs_axis = torch.arange(K, device=device)[:, None]
@@ -192,12 +196,17 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
             for start in range(0, args.batch_size, args.minibatch_size):
                 mb = permutation[:, start:start + args.minibatch_size]
                 with timer("update_forward"):
-                    mb_obs = b_obs[runs_axis, mb]
-                    if augment:  # the update's minibatch only: the rollout and evaluations see plain frames
-                        draws = plugins.augment_draws(random, AUGMENT_STREAM, counter, state.optimizer_steps)
-                        mb_obs = augment(mb_obs, draws)
+                    images = (mb // N * K + runs_axis) * N + mb % N
+                    if frames_in_place and not augment:
+                        inputs = (obs, images)
+                    else:
+                        mb_obs = frames_at(obs, images)
+                        if augment:  # the update's minibatch only: the rollout and evaluations see plain frames
+                            draws = plugins.augment_draws(random, AUGMENT_STREAM, counter, state.optimizer_steps)
+                            mb_obs = augment(mb_obs, draws)
+                        inputs = (mb_obs,)
                     with autocast(args.bf16):
-                        logits, new_value = agent(mb_obs)
+                        logits, new_value = agent(*inputs)
                     logits, new_value = logits.float(), new_value.float()
                     new_logprob = torch.log_softmax(logits, -1).gather(-1, b_actions[runs_axis, mb, None]).squeeze(-1)
                     loss, pg_loss, v_loss, entropy, approx_kl, clipfrac = ppo_loss(

@@ -15,28 +15,55 @@ import triton.language as tl
 
 from kage.ppo.fast.space_to_depth import space_to_depth, weight_space_to_depth
 
-# Channel counts are 48/128/64 in (after space-to-depth) and 32/64/64 out; a program's output tile covers
-# the whole output width (BLOCK_N) in the forward pass and the weight gradient, so the configs tune the rest.
+# The reduction spans are conv1's 8 x 3 = 24 frame bytes a filter row (read in place, stride 4), conv2's 2 x 128
+# (after space-to-depth) and conv3's 3 x 64; outputs are 32/64/64 channels. A program's output tile covers the
+# whole output width (BLOCK_N) in the forward pass and the weight gradient, so the configs tune the rest; the
+# 32-wide ones fit conv1's span.
 _FORWARD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_K": k}, num_warps=w, num_stages=s)
                     for m, k, w, s in ((128, 32, 4, 3), (128, 64, 4, 3), (64, 32, 4, 4), (128, 64, 8, 4))]
 _DGRAD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_N": n, "BLOCK_K": k}, num_warps=w, num_stages=s)
                   for m, n, k, w, s in ((128, 64, 32, 4, 3), (128, 128, 32, 8, 3), (64, 64, 64, 4, 4),
                                         (128, 64, 64, 8, 3))]
 _WGRAD_CONFIGS = [triton.Config({"BLOCK_D": d, "BLOCK_M": m}, num_warps=w, num_stages=s)
-                  for d, m, w, s in ((64, 64, 4, 3), (128, 64, 4, 3), (64, 128, 4, 4), (128, 128, 8, 3))]
-_SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "RELU"]
+                  for d, m, w, s in ((64, 64, 4, 3), (128, 64, 4, 3), (64, 128, 4, 4), (128, 128, 8, 3),
+                                     (32, 128, 4, 4))]
+_SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "STRIDE", "RELU", "FRAMES"]
+_DGRAD_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "RELU"]
+
+
+@triton.jit
+def _image_offsets(images_ptr, run, b, oh, ow, row_ok, B, H: tl.constexpr, W: tl.constexpr, CIN: tl.constexpr,
+                   STRIDE: tl.constexpr, FRAMES: tl.constexpr):
+    """The offset in x of each output position's top-left tap: image (run * B + b, or images[run, b] under
+    FRAMES), row STRIDE * oh, column STRIDE * ow (NHWC, 64-bit)."""
+    if FRAMES:
+        image = tl.load(images_ptr + run * B + b, mask=row_ok, other=0).to(tl.int64)
+    else:
+        image = run * B + b
+    return ((image * H + oh * STRIDE) * W + ow * STRIDE) * CIN
+
+
+@triton.jit
+def _as_compute_type(patch, dtype: tl.constexpr, FRAMES: tl.constexpr):
+    """Under FRAMES, uint8 values v as v / 255 rounded once to `dtype`: the bits of torch's
+    frames.to(dtype).div_(255) (an IEEE float32 quotient, then round to nearest even)."""
+    if FRAMES:
+        patch = tl.math.div_rn(patch.to(tl.float32), 255.0).to(dtype)
+    return patch
 
 
 @triton.autotune(configs=_FORWARD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
-def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
+def forward_kernel(x_ptr, images_ptr, w_ptr, bias_ptr, y_ptr, B,
                    H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
-                   CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr, RELU: tl.constexpr,
+                   CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                   STRIDE: tl.constexpr, RELU: tl.constexpr, FRAMES: tl.constexpr,
                    BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
-    """y[run, m, co] = bias + sum over (kh, kw, ci) of x[run, b, oh + kh, ow + kw, ci] * w[run, kh, kw, ci, co],
-    m = (b, oh, ow), then max(y, 0) under RELU. For one kh the (kw, ci) pairs are KW * CIN contiguous input
-    elements (NHWC), so the reduction walks kh and BLOCK_K-wide pieces of that span: contiguous, coalesced
-    loads."""
+    """y[run, m, co] = bias + sum over (kh, kw, ci) of x[image, S * oh + kh, S * ow + kw, ci] * w[run, kh, kw,
+    ci, co], m = (b, oh, ow), then max(y, 0) under RELU. The image is run * B + b, or under FRAMES images[run, b]
+    of uint8 frames, read as value / 255 in w's dtype (the minibatch's frames where the rollout stored them:
+    no gathered copy, no converted copy). For one kh the (kw, ci) pairs are KW * CIN contiguous input elements
+    (NHWC), so the reduction walks kh and BLOCK_K-wide pieces of that span: contiguous, coalesced loads."""
     STEPS: tl.constexpr = (KW * CIN + BLOCK_K - 1) // BLOCK_K
     run = tl.program_id(2).to(tl.int64)
     rows = tl.program_id(0) * BLOCK_M + tl.arange(0, BLOCK_M)
@@ -46,16 +73,16 @@ def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
     b = rows // (OH * OW)
     oh = rows // OW % OH
     ow = rows % OW
-    x_row = ((b * H + oh) * W + ow).to(tl.int64) * CIN  # the top-left tap of each output position
-    x_run = x_ptr + (run * B) * (H * W * CIN)
+    x_row = _image_offsets(images_ptr, run, b, oh, ow, row_ok, B, H, W, CIN, STRIDE, FRAMES)
     w_run = w_ptr + run * (KH * KW * CIN * COUT)
     acc = tl.zeros((BLOCK_M, BLOCK_N), dtype=tl.float32)
     for step in range(0, KH * STEPS):
         kh = step // STEPS
         span = step % STEPS * BLOCK_K + tl.arange(0, BLOCK_K)
         span_ok = span < KW * CIN
-        patch = tl.load(x_run + (x_row[:, None] + (kh * (W * CIN) + span)[None, :]),
-                        mask=row_ok[:, None] & span_ok[None, :], other=0.0)
+        patch = tl.load(x_ptr + (x_row[:, None] + (kh * (W * CIN) + span)[None, :]),
+                        mask=row_ok[:, None] & span_ok[None, :], other=0)
+        patch = _as_compute_type(patch, w_ptr.dtype.element_ty, FRAMES)
         weight = tl.load(w_run + ((kh * (KW * CIN) + span)[:, None] * COUT + cols[None, :]),
                          mask=span_ok[:, None] & col_ok[None, :], other=0.0)
         acc += tl.dot(patch, weight)
@@ -67,13 +94,13 @@ def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
              mask=row_ok[:, None] & col_ok[None, :])
 
 
-@triton.autotune(configs=_DGRAD_CONFIGS, key=_SHAPE_KEY)
+@triton.autotune(configs=_DGRAD_CONFIGS, key=_DGRAD_KEY)
 @triton.jit
 def dgrad_kernel(dy_ptr, y_ptr, w_ptr, dx_ptr, B,
                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
                  CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr, RELU: tl.constexpr,
                  BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
-    """Stride 1: dx[run, b, ih, iw, ci] = sum over (kh, kw, co) of dy[run, b, ih - kh, iw - kw, co] *
+    """Stride 1, on activations (the frames need no gradient): dx[run, b, ih, iw, ci] = sum over (kh, kw, co) of dy[run, b, ih - kh, iw - kw, co] *
     w[run, kh, kw, ci, co], the taps whose output position falls outside OH x OW masked off. Under RELU, dy is
     the gradient after the layer's ReLU: each element counts where the output y there is positive (ReLU's
     gradient, read where dy is read instead of in a pass of its own)."""
@@ -115,12 +142,13 @@ def dgrad_kernel(dy_ptr, y_ptr, w_ptr, dx_ptr, B,
 
 @triton.autotune(configs=_WGRAD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
-def wgrad_kernel(x_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLIT,
+def wgrad_kernel(x_ptr, images_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLIT,
                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
-                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr, RELU: tl.constexpr,
+                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                 STRIDE: tl.constexpr, RELU: tl.constexpr, FRAMES: tl.constexpr,
                  BLOCK_D: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_M: tl.constexpr):
-    """parts[run, part, kh, kw, ci, co] = sum over m in the part's CHUNK rows of x[run, b, oh + kh, ow + kw, ci]
-    * dy[run, m, co], and bias_parts[run, part, co] = the sum of those dy[run, m, co]. A program owns BLOCK_D
+    """parts[run, part, kh, kw, ci, co] = sum over m in the part's CHUNK rows of x[image, S * oh + kh, S * ow +
+    kw, ci] * dy[run, m, co] (the image as in forward_kernel, uint8 frames under FRAMES), and bias_parts[run, part, co] = the sum of those dy[run, m, co]. A program owns BLOCK_D
     contiguous (kw, ci) pairs of one kh (axis 0), BLOCK_N output channels (axis 1) and one (run, part) (axis 2):
     SPLIT parts per run spread M's up to 2 M rows over the GPU, each writing fp32 partial sums that the caller
     adds up; the programs of the first (kh, kw, ci) block also sum dy for the bias, on the tiles they load
@@ -136,7 +164,7 @@ def wgrad_kernel(x_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLI
     m_total = B * (OH * OW)
     start = part * CHUNK
     end = tl.minimum(start + CHUNK, m_total)
-    x_run = x_ptr + (run * B) * (H * W * CIN) + kh * (W * CIN)
+    x_kh = x_ptr + kh * (W * CIN)
     dy_run = dy_ptr + (run * B) * (OH * OW * COUT)
     y_run = y_ptr + (run * B) * (OH * OW * COUT)
     sums_bias = tl.program_id(0) == 0
@@ -148,9 +176,9 @@ def wgrad_kernel(x_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLI
         b = rows // (OH * OW)
         oh = rows // OW % OH
         ow = rows % OW
-        x_row = ((b * H + oh) * W + ow).to(tl.int64) * CIN
-        patch = tl.load(x_run + (x_row[:, None] + span[None, :]), mask=row_ok[:, None] & span_ok[None, :],
-                        other=0.0)
+        x_row = _image_offsets(images_ptr, run, b, oh, ow, row_ok, B, H, W, CIN, STRIDE, FRAMES)
+        patch = tl.load(x_kh + (x_row[:, None] + span[None, :]), mask=row_ok[:, None] & span_ok[None, :], other=0)
+        patch = _as_compute_type(patch, dy_ptr.dtype.element_ty, FRAMES)
         at = rows.to(tl.int64)[:, None] * COUT + cols[None, :]
         grad = tl.load(dy_run + at, mask=row_ok[:, None] & col_ok[None, :], other=0.0)
         if RELU:
@@ -178,19 +206,28 @@ def _wgrad_chunk(m: int, runs: int) -> int:
 
 
 def _shape_args(h: int, w: int, kh: int, kw: int, cin: int, cout: int, relu: bool) -> dict:
+    """The stride-1 shape constants every kernel takes."""
     return dict(H=h, W=w, OH=h - kh + 1, OW=w - kw + 1, CIN=cin, COUT=cout, KH=kh, KW=kw, RELU=relu)
 
 
-def _forward(x: torch.Tensor, w: torch.Tensor, bias: torch.Tensor, relu: bool) -> torch.Tensor:
-    """x [K, B, H, W, Cin], w [K, kh, kw, Cin, Cout] (x's dtype), bias [K * Cout] fp32 -> [K, B, OH, OW, Cout]
-    (through a ReLU under `relu`)."""
-    k, b, h, wd, cin = x.shape
+def _input_args(x: torch.Tensor, images, kh: int, kw: int, cout: int, stride: int, relu: bool) -> dict:
+    """The forward and weight-gradient kernels' shape constants for input x: activations [K, B, H, W, Cin], or
+    uint8 frames [..., H, W, Cin] read at `images` [K, B]."""
+    h, w, cin = x.shape[-3:]
+    return dict(H=h, W=w, OH=(h - kh) // stride + 1, OW=(w - kw) // stride + 1, CIN=cin, COUT=cout, KH=kh, KW=kw,
+                STRIDE=stride, RELU=relu, FRAMES=images is not None)
+
+
+def _forward(x: torch.Tensor, images, w: torch.Tensor, bias: torch.Tensor, stride: int, relu: bool) -> torch.Tensor:
+    """x [K, B, H, W, Cin] in w's dtype, or uint8 frames [..., H, W, Cin] at images [K, B]; w [K, kh, kw, Cin,
+    Cout], bias [K * Cout] fp32 -> [K, B, OH, OW, Cout] in w's dtype (through a ReLU under `relu`)."""
+    k, b = (images if images is not None else x).shape[:2]
     _, kh, kw, _, cout = w.shape
-    shape = _shape_args(h, wd, kh, kw, cin, cout, relu)
-    y = torch.empty((k, b, shape["OH"], shape["OW"], cout), device=x.device, dtype=x.dtype)
+    shape = _input_args(x, images, kh, kw, cout, stride, relu)
+    y = torch.empty((k, b, shape["OH"], shape["OW"], cout), device=x.device, dtype=w.dtype)
     block_n = _width_block(cout)
     grid = lambda meta: (triton.cdiv(b * shape["OH"] * shape["OW"], meta["BLOCK_M"]), triton.cdiv(cout, block_n), k)
-    forward_kernel[grid](x, w, bias, y, b, **shape, BLOCK_N=block_n)
+    forward_kernel[grid](x, images, w, bias, y, b, **shape, BLOCK_N=block_n)
     return y
 
 
@@ -205,56 +242,59 @@ def _dgrad(dy: torch.Tensor, y: torch.Tensor, w: torch.Tensor, h: int, wd: int, 
     return dx
 
 
-def _wgrad(x: torch.Tensor, dy: torch.Tensor, y: torch.Tensor, kh: int, kw: int,
+def _wgrad(x: torch.Tensor, images, dy: torch.Tensor, y: torch.Tensor, kh: int, kw: int, stride: int,
            relu: bool) -> Tuple[torch.Tensor, torch.Tensor]:
-    """x [K, B, H, W, Cin], dy and the output y [K, B, OH, OW, Cout] (same dtype) -> dw [K, kh, kw, Cin, Cout]
-    and db [K, Cout] in fp32; under `relu`, dy is taken where y > 0 only."""
-    k, b, h, wd, cin = x.shape
-    _, _, oh, ow, cout = dy.shape
+    """x as _forward takes it, dy and the output y [K, B, OH, OW, Cout] (the compute dtype) -> dw [K, kh, kw, Cin,
+    Cout] and db [K, Cout] in fp32; under `relu`, dy is taken where y > 0 only."""
+    k, b, oh, ow, cout = dy.shape
+    cin = x.shape[-1]
     chunk = _wgrad_chunk(b * oh * ow, k)
     split = triton.cdiv(b * oh * ow, chunk)
     parts = torch.empty((k, split, kh, kw, cin, cout), device=x.device, dtype=torch.float32)
     bias_parts = torch.empty((k, split, cout), device=x.device, dtype=torch.float32)
     block_n = _width_block(cout)
     grid = lambda meta: (kh * triton.cdiv(kw * cin, meta["BLOCK_D"]), triton.cdiv(cout, block_n), k * split)
-    wgrad_kernel[grid](x, dy, y, parts, bias_parts, b, chunk, split, **_shape_args(h, wd, kh, kw, cin, cout, relu),
-                       BLOCK_N=block_n)
+    wgrad_kernel[grid](x, images, dy, y, parts, bias_parts, b, chunk, split,
+                       **_input_args(x, images, kh, kw, cout, stride, relu), BLOCK_N=block_n)
     return parts.sum(dim=1), bias_parts.sum(dim=1)
 
 
-class _PackedConvStride1(torch.autograd.Function):
-    """The stride-1, unpadded packed convolution, with its ReLU under `relu`: x [K, B, H, W, Cin] (bf16 or fp32),
-    the grouped layout's weight [K * Cout, Cin, kh, kw] and bias [K * Cout] (any float dtype) -> [K, B, OH, OW,
-    Cout] in x's dtype. The kernels compute in x's dtype with fp32 sums (fp32 master weights arrive as they are
+class _PackedConv(torch.autograd.Function):
+    """The unpadded packed convolution, with its ReLU under `relu`, of x [K, B, H, W, Cin] (stride 1, bf16 or
+    fp32), or of uint8 frames [..., H, W, Cin] at images [K, B] (any stride, read as value / 255 in `dtype`);
+    the grouped layout's weight [K * Cout, Cin, kh, kw] and bias [K * Cout] (any float dtype) -> [K, B, OH,
+    OW, Cout] in `dtype`. The kernels compute in `dtype` with fp32 sums (fp32 master weights arrive as they are
     under autocast: cast here); the gradients come back in their inputs' dtypes. The ReLU is the forward
     kernel's epilogue, and its gradient is applied where the backward kernels read the incoming gradient: no
     pass of its own either way."""
 
     @staticmethod
-    def forward(ctx, x, weight, bias, relu):
-        k, cin = x.shape[0], x.shape[-1]
+    def forward(ctx, x, images, weight, bias, stride, dtype, relu):
+        k = (images if images is not None else x).shape[0]
+        cin = x.shape[-1]
         cout, kh, kw = weight.shape[0] // k, weight.shape[2], weight.shape[3]
         assert weight.shape[1] == cin and weight.shape[0] == k * cout, (x.shape, weight.shape)
+        assert images is not None or stride == 1, "activations take stride 1 (packed_conv cuts larger strides)"
         x = x.contiguous()
-        w = weight.reshape(k, cout, cin, kh, kw).permute(0, 3, 4, 2, 1).contiguous().to(x.dtype)
-        y = _forward(x, w, bias.to(torch.float32).contiguous(), relu)
-        ctx.save_for_backward(x, w, y)
-        ctx.relu, ctx.weight_dtype, ctx.bias_dtype = relu, weight.dtype, bias.dtype
+        w = weight.reshape(k, cout, cin, kh, kw).permute(0, 3, 4, 2, 1).contiguous().to(dtype)
+        y = _forward(x, images, w, bias.to(torch.float32).contiguous(), stride, relu)
+        ctx.save_for_backward(x, images, w, y)
+        ctx.stride, ctx.relu, ctx.weight_dtype, ctx.bias_dtype = stride, relu, weight.dtype, bias.dtype
         return y
 
     @staticmethod
     def backward(ctx, dy):
-        x, w, y = ctx.saved_tensors
-        k, _, h, wd, cin = x.shape
-        _, kh, kw, _, cout = w.shape
-        dy = dy.to(x.dtype).contiguous()
-        dx = _dgrad(dy, y, w, h, wd, ctx.relu) if ctx.needs_input_grad[0] else None  # frames need none
-        dw = db = None
-        if ctx.needs_input_grad[1] or ctx.needs_input_grad[2]:
-            dw, db = _wgrad(x, dy, y, kh, kw, ctx.relu)
+        x, images, w, y = ctx.saved_tensors
+        k, kh, kw, cin, cout = w.shape
+        dy = dy.to(y.dtype).contiguous()
+        dx = dw = db = None
+        if ctx.needs_input_grad[0]:  # activations only: frames are integers
+            dx = _dgrad(dy, y, w, x.shape[2], x.shape[3], ctx.relu)
+        if ctx.needs_input_grad[2] or ctx.needs_input_grad[3]:
+            dw, db = _wgrad(x, images, dy, y, kh, kw, ctx.stride, ctx.relu)
             dw = dw.permute(0, 4, 3, 1, 2).reshape(k * cout, cin, kh, kw).to(ctx.weight_dtype)
             db = db.reshape(-1).to(ctx.bias_dtype)
-        return dx, dw, db, None
+        return dx, None, dw, db, None, None, None
 
 
 def packed_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int = 1,
@@ -265,4 +305,15 @@ def packed_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, strid
     equal stride-1 convolution of s x s blocks (space_to_depth), which the kernels run."""
     if stride != 1:
         x, weight = space_to_depth(x, stride), weight_space_to_depth(weight, stride)
-    return _PackedConvStride1.apply(x, weight, bias, relu)
+    return _PackedConv.apply(x, None, weight, bias, 1, x.dtype, relu)
+
+
+def packed_conv_frames(frames: torch.Tensor, images: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor,
+                       stride: int, dtype: torch.dtype, relu: bool = False) -> torch.Tensor:
+    """packed_conv of K runs' uint8 frames / 255 in `dtype`, read where they are: run k's b-th frame is
+    frames.reshape(-1, H, W, C)[images[k, b]] (the rollout buffer and a minibatch's indices, or a batch
+    [K, B, H, W, C] and torch.arange(K * B).view(K, B)). The kernels stride over the frames directly: no
+    gathered, converted or space-to-depth copy is made, and the frames get no gradient."""
+    assert frames.dtype == torch.uint8 and images.dtype == torch.int64 and images.dim() == 2, (frames.dtype,
+                                                                                               images.shape)
+    return _PackedConv.apply(frames.contiguous(), images.contiguous(), weight, bias, stride, dtype, relu)
