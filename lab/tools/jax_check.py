@@ -133,9 +133,12 @@ def train(logs) -> str:
         last = ended[-1]["success_once"] if ended else [None] * seeds
         text = ", ".join("-" if v is None else f"{v:.2f}" for v in last)
         at = f" (iteration {ended[-1]['iteration']} of {records[-1]['iteration']})" if ended else ""
+        # The best value each seed reached, and where: a seed may learn, then collapse to never jumping.
+        best = [max(ended, key=lambda r: r["success_once"][s]) for s in range(seeds)] if ended else []
+        peaks = ", ".join(f"{r['success_once'][s]:.2f} (it. {r['iteration']})" for s, r in enumerate(best))
         lines.append(f"train {path}: {seeds} seed(s), {records[-1]['global_step']} steps each, steady "
                      f"{steady / 1e3:.1f} k steps/s over all seeds; train success_once per seed at the last "
-                     f"episode end{at}: {text}")
+                     f"episode end{at}: {text}; best per seed: {peaks or '-'}")
     return "\n".join(lines)
 
 
