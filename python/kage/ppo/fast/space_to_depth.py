@@ -1,6 +1,7 @@
 """Space-to-depth: a convolution whose kernel and stride are multiples of s, rewritten as the equal
 stride-1 convolution over s x s blocks of the input (more channels, fewer positions). --fused-input runs
-conv1 (8x8, stride 4) this way, --triton-conv conv1 and conv2 (4x4, stride 2). Pure torch, so the CPU
+conv1 (8x8, stride 4) this way, --triton-conv conv2 (4x4, stride 2; its conv1 strides over the frames).
+Pure torch, so the CPU
 tests check the formulas the GPU kernels rely on."""
 from typing import Optional
 
