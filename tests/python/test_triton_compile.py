@@ -1,6 +1,6 @@
 """kage.ppo.fast.triton_conv's kernels compiled for the H100 (sm_90) as the trainer runs them, in bfloat16, on a
 machine without a GPU: Triton's own compiler and the ptxas it ships, every autotuning config of every kernel, at
-each NatureCNN layer's shapes (conv1 on the uint8 frames, conv2 after space-to-depth), the fused ReLU in and out. The interpreter
+each NatureCNN layer's shapes (conv1 on the uint8 frames, conv2 at stride 2), the fused ReLU in and out. The interpreter
 (test_triton_interpreter.py) checks the values in float32 but never types bf16 code; this catches what only the
 compiler sees (dtype mismatches in tl.dot and tl.where, unsupported tile shapes) before a GPU lease is spent on it.
 The values in bf16 are checked on the GPU (tests/gpu/test_triton_conv.py)."""
@@ -13,8 +13,8 @@ from kage.ppo.fast import triton_conv as tc
 
 H100 = GPUTarget("cuda", 90, 32)
 # (name, H, W, Cin, Cout, kh, kw, stride) of the convolutions the kernels run: conv1 striding over the uint8
-# 128 x 128 x 3 frames, conv2 on 2x2 blocks of conv1's 31 x 31 x 32 output, conv3 as it is.
-LAYERS = [("conv1", 128, 128, 3, 32, 8, 8, 4), ("conv2", 15, 15, 128, 64, 2, 2, 1),
+# 128 x 128 x 3 frames, conv2 over conv1's 31 x 31 x 32 output, conv3 over conv2's.
+LAYERS = [("conv1", 128, 128, 3, 32, 8, 8, 4), ("conv2", 31, 31, 32, 64, 4, 4, 2),
           ("conv3", 14, 14, 64, 64, 3, 3, 1)]
 # Each kernel's pointer and run-time integer arguments, as _forward, _dgrad and _wgrad pass them under --bf16 on
 # activations; conv1's x is uint8 frames read at int64 image indices.
@@ -55,8 +55,9 @@ def test_kernel_compiles_for_the_h100_in_bf16(kernel, layer, index):
     name, h, w, cin, cout, kh, kw, stride = layer
     constants = dict(H=h, W=w, OH=(h - kh) // stride + 1, OW=(w - kw) // stride + 1, CIN=cin, COUT=cout, KH=kh,
                      KW=kw)
+    constants["STRIDE"] = stride
     if kernel is not tc.dgrad_kernel:  # their tiles span the whole output width (triton_conv._width_block)
-        constants.update(BLOCK_N=tc._width_block(cout), STRIDE=stride, FRAMES=name == "conv1")
+        constants.update(BLOCK_N=tc._width_block(cout), FRAMES=name == "conv1")
     # The fused ReLU under every config (the trainer's path); without it under the first.
     for relu in (True, False) if index == 0 else (True,):
         compiled = compile_for_h100(kernel, kernel.configs[index], dict(constants, RELU=relu))

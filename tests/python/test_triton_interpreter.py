@@ -3,8 +3,8 @@ torch's grouped convolutions (F.conv2d(groups=K), the plain layers) on the same 
 the trainer runs them, under each autotuning config of every kernel, K = 2 runs of B = 2 or 3 frames:
 - conv1 striding over uint8 frames where a rollout buffer holds them (a minibatch's shuffled indices), output
   and weight and bias gradients;
-- conv2 (the 2x2 stride-1 convolution of 2x2 blocks, 128 channels) and conv3 (3x3), output and input, weight
-  and bias gradients, alone and with the fused ReLU;
+- conv2 (4x4, stride 2, over conv1's 31 x 31 x 32 output) and conv3 (3x3), output and input, weight and bias
+  gradients, alone and with the fused ReLU;
 - the weight and bias gradients' split into partial sums;
 - the Agent's --triton-conv torso against its plain one, forward and parameter gradients, on a batch and on a
   minibatch read from a rollout buffer.
@@ -67,8 +67,9 @@ def grouped_layer(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, str
 
 # The trainer's fused ReLU under every config; the plain convolution under the first (the same kernels with the
 # ReLU's code compiled out), to keep the interpreter's time down.
-@pytest.mark.parametrize("config, relu", [(0, False), (0, True), (1, True), (2, True), (3, True)],
-                         ids=["config0", "config0_relu", "config1_relu", "config2_relu", "config3_relu"])
+@pytest.mark.parametrize("config, relu", [(0, False), (0, True), (1, True), (2, True), (3, True), (4, True)],
+                         ids=["config0", "config0_relu", "config1_relu", "config2_relu", "config3_relu",
+                              "config4_relu"])
 @pytest.mark.parametrize("layer", LAYERS, ids=[layer[0] for layer in LAYERS])
 def test_layer_equals_grouped_conv(layer, config, relu, monkeypatch):
     use_config(config, monkeypatch)

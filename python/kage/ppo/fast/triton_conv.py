@@ -1,8 +1,9 @@
 """The baseline's convolutions for K packed runs as Triton implicit-GEMM kernels (--triton-conv): the run is a
 grid axis instead of a channel group, so each layer and pass is one launch over all K runs, and the patches
 are never materialised (cuDNN runs grouped convolutions group by group with slicing copies; im2col + bmm
-moved more bytes than it saved: bench/results/2026-11-23-h100-packed-training-speed.md). Activations are
-[K, B, H, W, C] (NHWC per run); the parameters keep nn.Conv2d(groups=K)'s layout, so checkpoints are the
+moved more bytes than it saved: lab/2026-11-23-h100-packed-training-speed). Activations are [K, B, H, W, C]
+(NHWC per run), and each kernel strides over its input as it lies: conv1 over the rollout's uint8 frames,
+conv2 over conv1's output, so no layer's input is copied into another layout. The parameters keep nn.Conv2d(groups=K)'s layout, so checkpoints are the
 same. Imported only under --triton-conv: triton is a GPU-machine dependency (and the CI tests'). Checked and
 timed on the GPU by tests/gpu/test_triton_conv.py, and in float32 on the CPU under Triton's interpreter by
 tests/python/test_triton_interpreter.py.
@@ -13,22 +14,20 @@ import torch
 import triton
 import triton.language as tl
 
-from kage.ppo.fast.space_to_depth import space_to_depth, weight_space_to_depth
-
-# The reduction spans are conv1's 8 x 3 = 24 frame bytes a filter row (read in place, stride 4), conv2's 2 x 128
-# (after space-to-depth) and conv3's 3 x 64; outputs are 32/64/64 channels. A program's output tile covers the
+# The reduction spans are conv1's 8 x 3 = 24 frame bytes a filter row (read in place, stride 4), conv2's 4 x 32
+# (stride 2) and conv3's 3 x 64; outputs are 32/64/64 channels. A program's output tile covers the
 # whole output width (BLOCK_N) in the forward pass and the weight gradient, so the configs tune the rest; the
-# 32-wide ones fit conv1's span.
+# 32-wide ones fit conv1's span and conv2's 32 input channels (its input gradient's width).
 _FORWARD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_K": k}, num_warps=w, num_stages=s)
                     for m, k, w, s in ((128, 32, 4, 3), (128, 64, 4, 3), (64, 32, 4, 4), (128, 64, 8, 4))]
 _DGRAD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_N": n, "BLOCK_K": k}, num_warps=w, num_stages=s)
                   for m, n, k, w, s in ((128, 64, 32, 4, 3), (128, 128, 32, 8, 3), (64, 64, 64, 4, 4),
-                                        (128, 64, 64, 8, 3))]
+                                        (128, 64, 64, 8, 3), (128, 32, 64, 4, 3))]
 _WGRAD_CONFIGS = [triton.Config({"BLOCK_D": d, "BLOCK_M": m}, num_warps=w, num_stages=s)
                   for d, m, w, s in ((64, 64, 4, 3), (128, 64, 4, 3), (64, 128, 4, 4), (128, 128, 8, 3),
                                      (32, 128, 4, 4))]
 _SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "STRIDE", "RELU", "FRAMES"]
-_DGRAD_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "RELU"]
+_DGRAD_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "STRIDE", "RELU"]
 
 
 @triton.jit
@@ -98,45 +97,60 @@ def forward_kernel(x_ptr, images_ptr, w_ptr, bias_ptr, y_ptr, B,
 @triton.jit
 def dgrad_kernel(dy_ptr, y_ptr, w_ptr, dx_ptr, B,
                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
-                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr, RELU: tl.constexpr,
+                 CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
+                 STRIDE: tl.constexpr, RELU: tl.constexpr,
                  BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
-    """Stride 1, on activations (the frames need no gradient): dx[run, b, ih, iw, ci] = sum over (kh, kw, co) of dy[run, b, ih - kh, iw - kw, co] *
-    w[run, kh, kw, ci, co], the taps whose output position falls outside OH x OW masked off. Under RELU, dy is
-    the gradient after the layer's ReLU: each element counts where the output y there is positive (ReLU's
-    gradient, read where dy is read instead of in a pass of its own)."""
+    """On activations (the frames need no gradient): dx[run, b, ih, iw, ci] = sum over (kh, kw, co) of
+    dy[run, b, oh, ow, co] * w[run, kh, kw, ci, co] where ih = S * oh + kh and iw = S * ow + kw, 0 <= oh < OH,
+    0 <= ow < OW. A program owns input positions of one parity (ih % S, iw % S) = (ph, pw), so its taps are
+    the same for all its rows, kh = ph + S * j and kw = pw + S * l, at oh = ih // S - j, ow = iw // S - l:
+    the stride costs no masked work, and dx lands in the input's own layout (no space-to-depth copy, no
+    gradient of one). Under RELU, dy is the gradient after the layer's ReLU: each element counts where the
+    output y there is positive (ReLU's gradient, read where dy is read instead of in a pass of its own)."""
+    HC: tl.constexpr = (H + STRIDE - 1) // STRIDE  # positions of one parity along a column and a row
+    WC: tl.constexpr = (W + STRIDE - 1) // STRIDE
+    TAPS_H: tl.constexpr = KH // STRIDE
+    TAPS_W: tl.constexpr = KW // STRIDE
     STEPS: tl.constexpr = (COUT + BLOCK_K - 1) // BLOCK_K
+    COL_BLOCKS: tl.constexpr = (CIN + BLOCK_N - 1) // BLOCK_N
     run = tl.program_id(2).to(tl.int64)
+    parity = tl.program_id(1) // COL_BLOCKS
+    ph = parity // STRIDE
+    pw = parity % STRIDE
     rows = tl.program_id(0) * BLOCK_M + tl.arange(0, BLOCK_M)
-    cols = tl.program_id(1) * BLOCK_N + tl.arange(0, BLOCK_N)
-    row_ok = rows < B * (H * W)
+    cols = tl.program_id(1) % COL_BLOCKS * BLOCK_N + tl.arange(0, BLOCK_N)
+    b = rows // (HC * WC)
+    ih = rows // WC % HC * STRIDE + ph
+    iw = rows % WC * STRIDE + pw
+    row_ok = (rows < B * (HC * WC)) & (ih < H) & (iw < W)
     col_ok = cols < CIN
-    b = rows // (H * W)
-    ih = rows // W % H
-    iw = rows % W
-    # dy's offset of (b, ih, iw) as if that output position existed; tap (kh, kw) reads kh * OW + kw
+    # dy's offset of (b, ih // S, iw // S) as if that output position existed; tap (j, l) reads j * OW + l
     # positions before it, wherever the mask allows.
-    dy_row = ((b * OH + ih) * OW + iw).to(tl.int64) * COUT
+    dy_row = ((b * OH + ih // STRIDE) * OW + iw // STRIDE).to(tl.int64) * COUT
     dy_run = dy_ptr + (run * B) * (OH * OW * COUT)
     y_run = y_ptr + (run * B) * (OH * OW * COUT)
     w_run = w_ptr + run * (KH * KW * CIN * COUT)
     acc = tl.zeros((BLOCK_M, BLOCK_N), dtype=tl.float32)
-    for step in range(0, KH * KW * STEPS):
-        tap = step // STEPS
-        kh = tap // KW
-        kw = tap % KW
+    for step in range(0, TAPS_H * TAPS_W * STEPS):
+        j = step // STEPS // TAPS_W
+        l = step // STEPS % TAPS_W
         chans = step % STEPS * BLOCK_K + tl.arange(0, BLOCK_K)
         chan_ok = chans < COUT
-        tap_ok = row_ok & (ih >= kh) & (ih - kh < OH) & (iw >= kw) & (iw - kw < OW)
-        at = dy_row[:, None] + (chans - (kh * OW + kw) * COUT)[None, :]
+        oh = ih // STRIDE - j
+        ow = iw // STRIDE - l
+        tap_ok = row_ok & (oh >= 0) & (oh < OH) & (ow >= 0) & (ow < OW)
+        at = dy_row[:, None] + (chans - (j * OW + l) * COUT)[None, :]
         grad = tl.load(dy_run + at, mask=tap_ok[:, None] & chan_ok[None, :], other=0.0)
         if RELU:
             positive = tl.load(y_run + at, mask=tap_ok[:, None] & chan_ok[None, :], other=0.0) > 0
             grad = tl.where(positive, grad, tl.zeros_like(grad))
+        tap = (ph + STRIDE * j) * KW + pw + STRIDE * l
         weight = tl.load(w_run + ((tap * CIN + cols)[None, :] * COUT + chans[:, None]),
                          mask=chan_ok[:, None] & col_ok[None, :], other=0.0)
         acc += tl.dot(grad, weight)
+    dx_row = ((b * H + ih) * W + iw).to(tl.int64) * CIN
     dx_run = dx_ptr + (run * B) * (H * W * CIN)
-    tl.store(dx_run + (rows.to(tl.int64)[:, None] * CIN + cols[None, :]), acc.to(dx_ptr.dtype.element_ty),
+    tl.store(dx_run + (dx_row[:, None] + cols[None, :]), acc.to(dx_ptr.dtype.element_ty),
              mask=row_ok[:, None] & col_ok[None, :])
 
 
@@ -205,17 +219,10 @@ def _wgrad_chunk(m: int, runs: int) -> int:
     return max(2048, triton.cdiv(triton.cdiv(m, max(1, 512 // runs)), 128) * 128)
 
 
-def _shape_args(h: int, w: int, kh: int, kw: int, cin: int, cout: int, relu: bool) -> dict:
-    """The stride-1 shape constants every kernel takes."""
-    return dict(H=h, W=w, OH=h - kh + 1, OW=w - kw + 1, CIN=cin, COUT=cout, KH=kh, KW=kw, RELU=relu)
-
-
-def _input_args(x: torch.Tensor, images, kh: int, kw: int, cout: int, stride: int, relu: bool) -> dict:
-    """The forward and weight-gradient kernels' shape constants for input x: activations [K, B, H, W, Cin], or
-    uint8 frames [..., H, W, Cin] read at `images` [K, B]."""
-    h, w, cin = x.shape[-3:]
+def _shape_args(h: int, w: int, kh: int, kw: int, cin: int, cout: int, stride: int, relu: bool) -> dict:
+    """The shape constants every kernel takes, for an input of h x w x cin."""
     return dict(H=h, W=w, OH=(h - kh) // stride + 1, OW=(w - kw) // stride + 1, CIN=cin, COUT=cout, KH=kh, KW=kw,
-                STRIDE=stride, RELU=relu, FRAMES=images is not None)
+                STRIDE=stride, RELU=relu)
 
 
 def _forward(x: torch.Tensor, images, w: torch.Tensor, bias: torch.Tensor, stride: int, relu: bool) -> torch.Tensor:
@@ -223,22 +230,25 @@ def _forward(x: torch.Tensor, images, w: torch.Tensor, bias: torch.Tensor, strid
     Cout], bias [K * Cout] fp32 -> [K, B, OH, OW, Cout] in w's dtype (through a ReLU under `relu`)."""
     k, b = (images if images is not None else x).shape[:2]
     _, kh, kw, _, cout = w.shape
-    shape = _input_args(x, images, kh, kw, cout, stride, relu)
+    shape = _shape_args(*x.shape[-3:-1], kh, kw, x.shape[-1], cout, stride, relu)
     y = torch.empty((k, b, shape["OH"], shape["OW"], cout), device=x.device, dtype=w.dtype)
     block_n = _width_block(cout)
     grid = lambda meta: (triton.cdiv(b * shape["OH"] * shape["OW"], meta["BLOCK_M"]), triton.cdiv(cout, block_n), k)
-    forward_kernel[grid](x, images, w, bias, y, b, **shape, BLOCK_N=block_n)
+    forward_kernel[grid](x, images, w, bias, y, b, **shape, FRAMES=images is not None, BLOCK_N=block_n)
     return y
 
 
-def _dgrad(dy: torch.Tensor, y: torch.Tensor, w: torch.Tensor, h: int, wd: int, relu: bool) -> torch.Tensor:
-    """dy and the output y [K, B, OH, OW, Cout], w [K, kh, kw, Cin, Cout] (dy's dtype) -> dx [K, B, H, W, Cin];
-    under `relu`, dy is taken where y > 0 only."""
+def _dgrad(dy: torch.Tensor, y: torch.Tensor, w: torch.Tensor, h: int, wd: int, stride: int,
+           relu: bool) -> torch.Tensor:
+    """dy and the output y [K, B, OH, OW, Cout], w [K, kh, kw, Cin, Cout] (dy's dtype) -> dx [K, B, H, W, Cin]
+    (the stride dividing the kernel); under `relu`, dy is taken where y > 0 only."""
     k, b, _, _, cout = dy.shape
     _, kh, kw, cin, _ = w.shape
     dx = torch.empty((k, b, h, wd, cin), device=dy.device, dtype=dy.dtype)
-    grid = lambda meta: (triton.cdiv(b * h * wd, meta["BLOCK_M"]), triton.cdiv(cin, meta["BLOCK_N"]), k)
-    dgrad_kernel[grid](dy, y, w, dx, b, **_shape_args(h, wd, kh, kw, cin, cout, relu))
+    parity_rows = b * triton.cdiv(h, stride) * triton.cdiv(wd, stride)  # input positions of one parity
+    grid = lambda meta: (triton.cdiv(parity_rows, meta["BLOCK_M"]),
+                         stride * stride * triton.cdiv(cin, meta["BLOCK_N"]), k)
+    dgrad_kernel[grid](dy, y, w, dx, b, **_shape_args(h, wd, kh, kw, cin, cout, stride, relu))
     return dx
 
 
@@ -255,13 +265,15 @@ def _wgrad(x: torch.Tensor, images, dy: torch.Tensor, y: torch.Tensor, kh: int, 
     block_n = _width_block(cout)
     grid = lambda meta: (kh * triton.cdiv(kw * cin, meta["BLOCK_D"]), triton.cdiv(cout, block_n), k * split)
     wgrad_kernel[grid](x, images, dy, y, parts, bias_parts, b, chunk, split,
-                       **_input_args(x, images, kh, kw, cout, stride, relu), BLOCK_N=block_n)
+                       **_shape_args(*x.shape[-3:-1], kh, kw, cin, cout, stride, relu), FRAMES=images is not None,
+                       BLOCK_N=block_n)
     return parts.sum(dim=1), bias_parts.sum(dim=1)
 
 
 class _PackedConv(torch.autograd.Function):
-    """The unpadded packed convolution, with its ReLU under `relu`, of x [K, B, H, W, Cin] (stride 1, bf16 or
-    fp32), or of uint8 frames [..., H, W, Cin] at images [K, B] (any stride, read as value / 255 in `dtype`);
+    """The unpadded packed convolution, with its ReLU under `relu`, of x [K, B, H, W, Cin] (bf16 or fp32), or
+    of uint8 frames [..., H, W, Cin] at images [K, B] (read as value / 255 in `dtype`), at a stride that divides
+    the kernel;
     the grouped layout's weight [K * Cout, Cin, kh, kw] and bias [K * Cout] (any float dtype) -> [K, B, OH,
     OW, Cout] in `dtype`. The kernels compute in `dtype` with fp32 sums (fp32 master weights arrive as they are
     under autocast: cast here); the gradients come back in their inputs' dtypes. The ReLU is the forward
@@ -274,7 +286,7 @@ class _PackedConv(torch.autograd.Function):
         cin = x.shape[-1]
         cout, kh, kw = weight.shape[0] // k, weight.shape[2], weight.shape[3]
         assert weight.shape[1] == cin and weight.shape[0] == k * cout, (x.shape, weight.shape)
-        assert images is not None or stride == 1, "activations take stride 1 (packed_conv cuts larger strides)"
+        assert kh % stride == 0 and kw % stride == 0, (weight.shape, stride)
         x = x.contiguous()
         w = weight.reshape(k, cout, cin, kh, kw).permute(0, 3, 4, 2, 1).contiguous().to(dtype)
         y = _forward(x, images, w, bias.to(torch.float32).contiguous(), stride, relu)
@@ -289,7 +301,7 @@ class _PackedConv(torch.autograd.Function):
         dy = dy.to(y.dtype).contiguous()
         dx = dw = db = None
         if ctx.needs_input_grad[0]:  # activations only: frames are integers
-            dx = _dgrad(dy, y, w, x.shape[2], x.shape[3], ctx.relu)
+            dx = _dgrad(dy, y, w, x.shape[2], x.shape[3], ctx.stride, ctx.relu)
         if ctx.needs_input_grad[2] or ctx.needs_input_grad[3]:
             dw, db = _wgrad(x, images, dy, y, kh, kw, ctx.stride, ctx.relu)
             dw = dw.permute(0, 4, 3, 1, 2).reshape(k * cout, cin, kh, kw).to(ctx.weight_dtype)
@@ -301,11 +313,9 @@ def packed_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, strid
                 relu: bool = False) -> torch.Tensor:
     """K runs' unpadded convolutions at once: x [K, B, H, W, Cin], weight [K * Cout, Cin, kh, kw] and bias
     [K * Cout] as nn.Conv2d(groups=K) holds them -> [K, B, OH, OW, Cout], through a ReLU under `relu`
-    (F.relu(packed_conv(...)) without the ReLU's passes). A stride s > 1 (kernel a multiple of s) becomes the
-    equal stride-1 convolution of s x s blocks (space_to_depth), which the kernels run."""
-    if stride != 1:
-        x, weight = space_to_depth(x, stride), weight_space_to_depth(weight, stride)
-    return _PackedConv.apply(x, None, weight, bias, 1, x.dtype, relu)
+    (F.relu(packed_conv(...)) without the ReLU's passes). The stride must divide the kernel; the kernels stride
+    over x as it lies."""
+    return _PackedConv.apply(x, None, weight, bias, stride, x.dtype, relu)
 
 
 def packed_conv_frames(frames: torch.Tensor, images: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor,
@@ -313,7 +323,7 @@ def packed_conv_frames(frames: torch.Tensor, images: torch.Tensor, weight: torch
     """packed_conv of K runs' uint8 frames / 255 in `dtype`, read where they are: run k's b-th frame is
     frames.reshape(-1, H, W, C)[images[k, b]] (the rollout buffer and a minibatch's indices, or a batch
     [K, B, H, W, C] and torch.arange(K * B).view(K, B)). The kernels stride over the frames directly: no
-    gathered, converted or space-to-depth copy is made, and the frames get no gradient."""
+    gathered or converted copy is made, and the frames get no gradient."""
     assert frames.dtype == torch.uint8 and images.dtype == torch.int64 and images.dim() == 2, (frames.dtype,
                                                                                                images.shape)
     return _PackedConv.apply(frames.contiguous(), images.contiguous(), weight, bias, stride, dtype, relu)
