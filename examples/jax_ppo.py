@@ -212,7 +212,10 @@ def main() -> None:
     env = kage.jax.make_env(args.config, args.num_envs)
     init, iteration = make_train(args, env)
     seeds = args.seed + jnp.arange(args.num_seeds)
-    runner = jax.jit(jax.vmap(init))(seeds)
+    # Op by op, not jitted: in one jitted program XLA's CPU runtime may run several batched QR factorisations
+    # (the orthogonal initialisations) at once, each waiting on its own tasks in the same thread pool, which
+    # deadlocks when the pool has as few threads as they are (seen with jaxlib 0.10 on 2 cores). It runs once.
+    runner = jax.vmap(init)(seeds)
     # One program for every agent's whole iteration; the runner (environment state included) is donated,
     # so XLA updates it in place.
     train_iteration = jax.jit(jax.vmap(iteration), donate_argnums=0)
