@@ -124,6 +124,17 @@ def test_a_killed_reports_temporary_files_are_removed_by_the_next_report(bench):
     assert not any(stray.exists() for stray in strays)
 
 
+@pytest.mark.parametrize("text, found", [("[]", "not an object"), ('{"seeds": ["1"]}', "'seeds'"),
+                                         ('{"units": [3], "seeds": [1]}', "'units'")], ids=["list", "seeds", "units"])
+def test_a_damaged_bench_json_is_refused_by_name(tmp_path, text, found):
+    (tmp_path / "suite.json").write_text(json.dumps(SUITE))
+    (tmp_path / "bench.json").write_text(text)
+    with pytest.raises(SystemExit) as refused:
+        report.report(str(tmp_path))
+    message = str(refused.value)
+    assert str(tmp_path / "bench.json") in message and found in message and "fix or delete it" in message, message
+
+
 def by_name(entries, key, name):
     return next(e for e in entries if e[key] == name)
 

@@ -68,6 +68,7 @@ from dataclasses import dataclass, field
 from typing import Dict, List, NoReturn, Optional, Sequence, Tuple
 
 from kage.bench import intervals, plots
+from kage.bench.records import bench_problem
 from kage.bench.units import Unit, units_of
 from kage.bench.tables import METRICS, PROTOCOL_TEXTS, SUCCESS_SHOWN, write_tables
 from kage.util.files import atomic_write, output_folder, safe
@@ -127,14 +128,10 @@ def read_bench(bench_dir: str) -> dict:
     path = os.path.join(bench_dir, "bench.json")
     if not os.path.exists(path):
         return {}
-    fix = "fix or delete it (the report reads only its seeds and units)"
-    bench = read_json(path, fix)
-    if not isinstance(bench, dict):
-        return {}
-    for key, kind in (("units", str), ("seeds", int)):
-        if key in bench and not (isinstance(bench[key], list) and
-                                 all(isinstance(v, kind) and not isinstance(v, bool) for v in bench[key])):
-            fail(f"{path}: its '{key}' is not a list of {kind.__name__}s: {fix}")
+    bench = read_json(path, "fix or delete it (the report reads only its seeds and units)")
+    problem = bench_problem(bench, [k for k in ("units", "seeds") if isinstance(bench, dict) and k in bench])
+    if problem:
+        fail(f"{path} is damaged ({problem}): fix or delete it (the report reads only its seeds and units)")
     return bench
 
 

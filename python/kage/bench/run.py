@@ -41,6 +41,7 @@ from typing import Dict, List, Optional
 from kage import front_end, resources
 from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
+from kage.bench.records import bench_problem, suite_problem
 from kage.bench.units import Unit, select, units_of
 from kage.errors import ConfigError
 from kage.util.files import atomic_write, os_error_text, read_json_record, remove_strays, write_json
@@ -114,32 +115,6 @@ def share_training(units: List[Unit], report: dict) -> List[Unit]:
             for u in chunk[1:]:
                 shared[u.name] = []
     return [v for u in units for v in shared.get(u.name, [u])]
-
-
-def strings(value) -> bool:
-    return isinstance(value, list) and all(isinstance(v, str) for v in value)
-
-
-def bench_problem(bench, keys=("units", "seeds", "trainer_args")) -> Optional[str]:
-    """What bench.json's content lacks of `keys`: its units, seeds and trainer flags."""
-    if not isinstance(bench, dict):
-        return f"a JSON {type(bench).__name__}, not an object"
-    for key, valid in (("units", strings), ("trainer_args", strings), ("seeds", lambda v: isinstance(v, list) and all(
-            isinstance(s, int) and not isinstance(s, bool) for s in v))):
-        if key in keys and not valid(bench.get(key)):
-            return f"no valid '{key}'"
-    return None
-
-
-def suite_problem(suite) -> Optional[str]:
-    """What suite.json's content lacks: each pair's name and its two sides' spec hashes."""
-    pairs = suite.get("pairs") if isinstance(suite, dict) else None
-    if not isinstance(pairs, list) or not all(
-            isinstance(p, dict) and isinstance(p.get("pair"), str) and
-            all(isinstance(p.get(side), dict) and isinstance(p[side].get("spec_sha256"), str)
-                for side in ("train", "eval")) for p in pairs):
-        return "not a suite report with each pair's name and spec hashes"
-    return None
 
 
 def read_record(path: str, problem_of) -> dict:

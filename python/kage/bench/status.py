@@ -1,14 +1,15 @@
 """python3 -m kage.bench status DIR: where a benchmark stands, from the files its processes write (any
 number of them, on any hosts: a Slurm array, GPU workers, plain runs): runs done, running, failed (with
 the last error of each), stopped or killed (they resume when run again), and not started."""
-import json
 import os
 import time
 from typing import Dict, List, TextIO
 
 from kage.bench import run_state
-from kage.bench.run import bench_problem, checkpoint_iteration
+from kage.bench.records import bench_problem
+from kage.bench.run import checkpoint_iteration
 from kage.bench.tasks import run_dir
+from kage.util.files import read_json_record
 
 ORDER = ("done", "running", "failed", "interrupted", "not started")
 
@@ -46,11 +47,9 @@ def status(bench_dir: str, out: TextIO) -> Dict[str, List[str]]:
     """Prints the benchmark's state; returns category -> the runs in it."""
     path = os.path.join(bench_dir, "bench.json")
     try:
-        with open(path) as f:
-            bench = json.load(f)
-        problem = bench_problem(bench, ("units", "seeds"))
-    except (OSError, ValueError) as e:
-        problem = getattr(e, "strerror", None) or f"not JSON ({e})"
+        bench, problem = read_json_record(path, lambda value: bench_problem(value, ("units", "seeds")))
+    except OSError as e:
+        problem = e.strerror or str(e)
     if problem:
         raise SystemExit(f"{path}: error: {problem}: not a directory written by python3 -m kage.bench run (or slurm), "
                          "or that file is damaged (restore it, or run the benchmark's command again to rewrite it)")
