@@ -1,8 +1,9 @@
 """kage.ppo.fast.triton_conv's kernels (--triton-conv) on the CPU under Triton's interpreter, in float32, against
 torch's grouped convolutions (F.conv2d(groups=K), the plain layers) on the same values, the NatureCNN's layers as
 the trainer runs them, under each autotuning config of every kernel, K = 2 runs of B = 2 or 3 frames:
-- conv1 striding over uint8 frames where a rollout buffer holds them (a minibatch's shuffled indices), output
-  and weight and bias gradients;
+- the gather of a minibatch's uint8 frames from a rollout buffer into 4 x 4 blocks;
+- conv1 on those blocks, the frames at a minibatch's shuffled indices of a rollout buffer, output and weight and
+  bias gradients;
 - conv2 (4x4, stride 2, over conv1's 31 x 31 x 32 output) and conv3 (3x3), output and input, weight and bias
   gradients, alone and with the fused ReLU;
 - the weight and bias gradients' split into partial sums;
@@ -96,11 +97,25 @@ def test_layer_equals_grouped_conv(layer, config, relu, monkeypatch):
         assert relative_error(g, w) <= TOLERANCE, (name, quantity, relative_error(g, w))
 
 
+def test_frames_to_blocks_gathers_and_cuts():
+    """frames_to_blocks against torch's indexing and the space-to-depth reshape (channel (c, p, q) of block
+    (i, j) is pixel (4i + p, 4j + q) channel c), on frames whose side is no multiple of 4 (the last 2 rows and
+    columns are dropped) from a [T, K, N] buffer at shuffled indices."""
+    generator = torch.Generator().manual_seed(5)
+    buffer = torch.randint(0, 256, (2, 2, 3, 66, 66, 3), dtype=torch.uint8, generator=generator)
+    images = torch.randperm(12, generator=generator)[:6].view(2, 3)
+    got = tc.frames_to_blocks(buffer, images, 4)
+    frames = buffer.reshape(-1, 66, 66, 3)[images][:, :, :64, :64]
+    want = frames.reshape(2, 3, 16, 4, 16, 4, 3).permute(0, 1, 2, 4, 6, 3, 5).reshape(2, 3, 16, 16, 48)
+    assert got.dtype == torch.uint8 and torch.equal(got, want)
+
+
 @pytest.mark.parametrize("config", range(len(tc.wgrad_kernel.configs)))
 def test_conv1_reads_frames_in_place(config, monkeypatch):
-    """conv1 (8x8, stride 4, ReLU) as the trainer's update runs it: uint8 frames read where a [T, K, N] rollout
-    buffer holds them, at a minibatch's shuffled indices, scaled by 1 / 255 as they are read. The output and
-    the weight and bias gradients equal the plain layer's on the gathered frames / 255."""
+    """conv1 (8x8, stride 4, ReLU) as the trainer's update runs it: uint8 frames gathered from where a [T, K, N]
+    rollout buffer holds them, at a minibatch's shuffled indices, into 4 x 4 blocks read as integers, the
+    1 / 255 in the weight. The output and the weight and bias gradients equal the plain layer's on the gathered
+    frames / 255."""
     use_config(config, monkeypatch)
     steps, k, envs, side, cout = 2, 2, 3, 128, 32
     generator = torch.Generator().manual_seed(config)
@@ -141,7 +156,7 @@ def test_weight_gradient_partial_sums(chunk, monkeypatch):
     dy = torch.randn(y.shape, generator=generator)
     dw_ref, db_ref = torch.autograd.grad(y, (weight, bias), dy)
 
-    dw, db = tc._wgrad(x, None, dy, y.detach().contiguous(), ksize, ksize, 1, relu=True)  # [K, kh, kw, Cin, Cout], [K, Cout]
+    dw, db = tc._wgrad(x, dy, y.detach().contiguous(), ksize, ksize, 1, relu=True)  # [K, kh, kw, Cin, Cout], [K, Cout]
     assert relative_error(dw, dw_ref.reshape(k, cout, cin, ksize, ksize).permute(0, 3, 4, 2, 1)) <= TOLERANCE
     assert relative_error(db, db_ref.reshape(k, cout)) <= TOLERANCE
 

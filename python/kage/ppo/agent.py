@@ -130,8 +130,8 @@ class Agent(nn.Module):
 
     def _torso_triton(self, obs: torch.Tensor, images: Optional[torch.Tensor]) -> torch.Tensor:
         """The three convolutions on kage.ppo.fast.triton_conv's kernels (--triton-conv): the runs as a batch index
-        instead of channel groups, activations [K, B, H, W, C], the same parameters; conv1 strides over the
-        uint8 frames where they lie (scaled by 1 / 255 as it reads them). Returns [K, B, flat] in each run's
+        instead of channel groups, activations [K, B, H, W, C], the same parameters; conv1 on the minibatch's
+        uint8 frames gathered into 4 x 4 blocks, the 1 / 255 in its weight. Returns [K, B, flat] in each run's
         (channel, row, column) order."""
         from kage.ppo.fast import triton_conv  # here, not at the top: triton is needed only under the flag
         if images is None:

@@ -2,10 +2,13 @@
 grid axis instead of a channel group, so each layer and pass is one launch over all K runs, and the patches
 are never materialised (cuDNN runs grouped convolutions group by group with slicing copies; im2col + bmm
 moved more bytes than it saved: lab/2026-11-23-h100-packed-training-speed). Activations are [K, B, H, W, C]
-(NHWC per run), and each kernel strides over its input as it lies: conv1 over the rollout's uint8 frames,
-conv2 over conv1's output, so no layer's input is copied into another layout. The parameters keep nn.Conv2d(groups=K)'s layout, so checkpoints are the
-same. Imported only under --triton-conv: triton is a GPU-machine dependency (and the CI tests'). Checked and
-timed on the GPU by tests/gpu/test_triton_conv.py, and in float32 on the CPU under Triton's interpreter by
+(NHWC per run). conv1 runs as the equal 2 x 2 convolution over 4 x 4 blocks of the frames (space-to-depth):
+one kernel gathers a minibatch's uint8 frames from the rollout buffer straight into blocks (the gather and the
+rearrangement in one pass, still uint8), and the kernels read those bytes as the integers they are, the 1 / 255
+folded into conv1's weight. conv2 and conv3 stride over their input as it lies, so no activation is copied into
+another layout. The parameters keep nn.Conv2d(groups=K)'s layout, so checkpoints are the same. Imported only
+under --triton-conv: triton is a GPU-machine dependency (and the CI tests'). Checked and timed on the GPU by
+tests/gpu/test_triton_conv.py, and in float32 on the CPU under Triton's interpreter by
 tests/python/test_triton_interpreter.py.
 """
 from typing import Tuple
@@ -14,8 +17,10 @@ import torch
 import triton
 import triton.language as tl
 
-# The reduction spans are conv1's 8 x 3 = 24 frame bytes a filter row (read in place, stride 4), conv2's 4 x 32
-# (stride 2) and conv3's 3 x 64; outputs are 32/64/64 channels. A program's output tile covers the
+from kage.ppo.fast.space_to_depth import weight_space_to_depth
+
+# The reduction spans are conv1's 2 x 48 block bytes a filter row, conv2's 4 x 32 (stride 2) and conv3's 3 x 64;
+# outputs are 32/64/64 channels. A program's output tile covers the
 # whole output width (BLOCK_N) in the forward pass and the weight gradient, so the configs tune the rest; the
 # 32-wide ones fit conv1's span and conv2's 32 input channels (its input gradient's width).
 _FORWARD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_K": k}, num_warps=w, num_stages=s)
@@ -26,43 +31,42 @@ _DGRAD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_N": n, "BLOCK_K": k}, num_
 _WGRAD_CONFIGS = [triton.Config({"BLOCK_D": d, "BLOCK_M": m}, num_warps=w, num_stages=s)
                   for d, m, w, s in ((64, 64, 4, 3), (128, 64, 4, 3), (64, 128, 4, 4), (128, 128, 8, 3),
                                      (32, 128, 4, 4))]
-_SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "STRIDE", "RELU", "FRAMES"]
-_DGRAD_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "STRIDE", "RELU"]
+_SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "STRIDE", "RELU"]
 
 
 @triton.jit
-def _image_offsets(images_ptr, run, b, oh, ow, row_ok, B, H: tl.constexpr, W: tl.constexpr, CIN: tl.constexpr,
-                   STRIDE: tl.constexpr, FRAMES: tl.constexpr):
-    """The offset in x of each output position's top-left tap: image (run * B + b, or images[run, b] under
-    FRAMES), row STRIDE * oh, column STRIDE * ow (NHWC, 64-bit)."""
-    if FRAMES:
-        image = tl.load(images_ptr + run * B + b, mask=row_ok, other=0).to(tl.int64)
-    else:
-        image = run * B + b
-    return ((image * H + oh * STRIDE) * W + ow * STRIDE) * CIN
-
-
-@triton.jit
-def _as_compute_type(patch, dtype: tl.constexpr, FRAMES: tl.constexpr):
-    """Under FRAMES, uint8 values v as v / 255 rounded once to `dtype`: the bits of torch's
-    frames.to(dtype).div_(255) (an IEEE float32 quotient, then round to nearest even)."""
-    if FRAMES:
-        patch = tl.math.div_rn(patch.to(tl.float32), 255.0).to(dtype)
-    return patch
+def blocks_kernel(frames_ptr, images_ptr, blocks_ptr, H: tl.constexpr, W: tl.constexpr, C: tl.constexpr,
+                  S: tl.constexpr, BLOCK: tl.constexpr):
+    """blocks[i, bh, bw, (c, p, q)] = frames[images[i], S * bh + p, S * bw + q, c] (uint8, NHWC frames): one
+    program moves one strip of S image rows, which is one contiguous row of blocks, so its stores are
+    contiguous and its loads stay within the strip's S * W * C bytes."""
+    STRIP: tl.constexpr = W // S * S * S * C
+    i = tl.program_id(0).to(tl.int64)
+    bh = tl.program_id(1)
+    at = tl.arange(0, BLOCK)
+    ok = at < STRIP
+    bw = at // (S * S * C)
+    channel = at % (S * S * C)
+    c = channel // (S * S)
+    p = channel // S % S
+    q = channel % S
+    image = tl.load(images_ptr + i).to(tl.int64)
+    pixels = tl.load(frames_ptr + (((image * H + bh * S + p) * W + bw * S + q) * C + c), mask=ok)
+    tl.store(blocks_ptr + ((i * (H // S) + bh) * STRIP + at), pixels, mask=ok)
 
 
 @triton.autotune(configs=_FORWARD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
-def forward_kernel(x_ptr, images_ptr, w_ptr, bias_ptr, y_ptr, B,
+def forward_kernel(x_ptr, w_ptr, bias_ptr, y_ptr, B,
                    H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
                    CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
-                   STRIDE: tl.constexpr, RELU: tl.constexpr, FRAMES: tl.constexpr,
+                   STRIDE: tl.constexpr, RELU: tl.constexpr,
                    BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
     """y[run, m, co] = bias + sum over (kh, kw, ci) of x[image, S * oh + kh, S * ow + kw, ci] * w[run, kh, kw,
-    ci, co], m = (b, oh, ow), then max(y, 0) under RELU. The image is run * B + b, or under FRAMES images[run, b]
-    of uint8 frames, read as value / 255 in w's dtype (the minibatch's frames where the rollout stored them:
-    no gathered copy, no converted copy). For one kh the (kw, ci) pairs are KW * CIN contiguous input elements
-    (NHWC), so the reduction walks kh and BLOCK_K-wide pieces of that span: contiguous, coalesced loads."""
+    ci, co], m = (b, oh, ow), image = run * B + b, then max(y, 0) under RELU. x is read in w's dtype (uint8
+    blocks of frames as the integers they are). For one kh the (kw, ci) pairs are KW * CIN contiguous input
+    elements (NHWC), so the reduction walks kh and BLOCK_K-wide pieces of that span: contiguous, coalesced
+    loads."""
     STEPS: tl.constexpr = (KW * CIN + BLOCK_K - 1) // BLOCK_K
     run = tl.program_id(2).to(tl.int64)
     rows = tl.program_id(0) * BLOCK_M + tl.arange(0, BLOCK_M)
@@ -72,7 +76,7 @@ def forward_kernel(x_ptr, images_ptr, w_ptr, bias_ptr, y_ptr, B,
     b = rows // (OH * OW)
     oh = rows // OW % OH
     ow = rows % OW
-    x_row = _image_offsets(images_ptr, run, b, oh, ow, row_ok, B, H, W, CIN, STRIDE, FRAMES)
+    x_row = (((run * B + b) * H + oh * STRIDE) * W + ow * STRIDE) * CIN
     w_run = w_ptr + run * (KH * KW * CIN * COUT)
     acc = tl.zeros((BLOCK_M, BLOCK_N), dtype=tl.float32)
     for step in range(0, KH * STEPS):
@@ -80,8 +84,7 @@ def forward_kernel(x_ptr, images_ptr, w_ptr, bias_ptr, y_ptr, B,
         span = step % STEPS * BLOCK_K + tl.arange(0, BLOCK_K)
         span_ok = span < KW * CIN
         patch = tl.load(x_ptr + (x_row[:, None] + (kh * (W * CIN) + span)[None, :]),
-                        mask=row_ok[:, None] & span_ok[None, :], other=0)
-        patch = _as_compute_type(patch, w_ptr.dtype.element_ty, FRAMES)
+                        mask=row_ok[:, None] & span_ok[None, :], other=0).to(w_ptr.dtype.element_ty)
         weight = tl.load(w_run + ((kh * (KW * CIN) + span)[:, None] * COUT + cols[None, :]),
                          mask=span_ok[:, None] & col_ok[None, :], other=0.0)
         acc += tl.dot(patch, weight)
@@ -93,7 +96,7 @@ def forward_kernel(x_ptr, images_ptr, w_ptr, bias_ptr, y_ptr, B,
              mask=row_ok[:, None] & col_ok[None, :])
 
 
-@triton.autotune(configs=_DGRAD_CONFIGS, key=_DGRAD_KEY)
+@triton.autotune(configs=_DGRAD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
 def dgrad_kernel(dy_ptr, y_ptr, w_ptr, dx_ptr, B,
                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
@@ -156,13 +159,14 @@ def dgrad_kernel(dy_ptr, y_ptr, w_ptr, dx_ptr, B,
 
 @triton.autotune(configs=_WGRAD_CONFIGS, key=_SHAPE_KEY)
 @triton.jit
-def wgrad_kernel(x_ptr, images_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLIT,
+def wgrad_kernel(x_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLIT,
                  H: tl.constexpr, W: tl.constexpr, OH: tl.constexpr, OW: tl.constexpr,
                  CIN: tl.constexpr, COUT: tl.constexpr, KH: tl.constexpr, KW: tl.constexpr,
-                 STRIDE: tl.constexpr, RELU: tl.constexpr, FRAMES: tl.constexpr,
+                 STRIDE: tl.constexpr, RELU: tl.constexpr,
                  BLOCK_D: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_M: tl.constexpr):
     """parts[run, part, kh, kw, ci, co] = sum over m in the part's CHUNK rows of x[image, S * oh + kh, S * ow +
-    kw, ci] * dy[run, m, co] (the image as in forward_kernel, uint8 frames under FRAMES), and bias_parts[run, part, co] = the sum of those dy[run, m, co]. A program owns BLOCK_D
+    kw, ci] * dy[run, m, co] (the image and x's reading as in forward_kernel), and bias_parts[run, part, co] =
+    the sum of those dy[run, m, co]. A program owns BLOCK_D
     contiguous (kw, ci) pairs of one kh (axis 0), BLOCK_N output channels (axis 1) and one (run, part) (axis 2):
     SPLIT parts per run spread M's up to 2 M rows over the GPU, each writing fp32 partial sums that the caller
     adds up; the programs of the first (kh, kw, ci) block also sum dy for the bias, on the tiles they load
@@ -190,9 +194,9 @@ def wgrad_kernel(x_ptr, images_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B,
         b = rows // (OH * OW)
         oh = rows // OW % OH
         ow = rows % OW
-        x_row = _image_offsets(images_ptr, run, b, oh, ow, row_ok, B, H, W, CIN, STRIDE, FRAMES)
-        patch = tl.load(x_kh + (x_row[:, None] + span[None, :]), mask=row_ok[:, None] & span_ok[None, :], other=0)
-        patch = _as_compute_type(patch, dy_ptr.dtype.element_ty, FRAMES)
+        x_row = (((run * B + b) * H + oh * STRIDE) * W + ow * STRIDE) * CIN
+        patch = tl.load(x_kh + (x_row[:, None] + span[None, :]), mask=row_ok[:, None] & span_ok[None, :],
+                        other=0).to(dy_ptr.dtype.element_ty)
         at = rows.to(tl.int64)[:, None] * COUT + cols[None, :]
         grad = tl.load(dy_run + at, mask=row_ok[:, None] & col_ok[None, :], other=0.0)
         if RELU:
@@ -225,16 +229,16 @@ def _shape_args(h: int, w: int, kh: int, kw: int, cin: int, cout: int, stride: i
                 STRIDE=stride, RELU=relu)
 
 
-def _forward(x: torch.Tensor, images, w: torch.Tensor, bias: torch.Tensor, stride: int, relu: bool) -> torch.Tensor:
-    """x [K, B, H, W, Cin] in w's dtype, or uint8 frames [..., H, W, Cin] at images [K, B]; w [K, kh, kw, Cin,
-    Cout], bias [K * Cout] fp32 -> [K, B, OH, OW, Cout] in w's dtype (through a ReLU under `relu`)."""
-    k, b = (images if images is not None else x).shape[:2]
+def _forward(x: torch.Tensor, w: torch.Tensor, bias: torch.Tensor, stride: int, relu: bool) -> torch.Tensor:
+    """x [K, B, H, W, Cin] in w's dtype or uint8; w [K, kh, kw, Cin, Cout], bias [K * Cout] fp32 -> [K, B, OH,
+    OW, Cout] in w's dtype (through a ReLU under `relu`)."""
+    k, b = x.shape[:2]
     _, kh, kw, _, cout = w.shape
     shape = _shape_args(*x.shape[-3:-1], kh, kw, x.shape[-1], cout, stride, relu)
     y = torch.empty((k, b, shape["OH"], shape["OW"], cout), device=x.device, dtype=w.dtype)
     block_n = _width_block(cout)
     grid = lambda meta: (triton.cdiv(b * shape["OH"] * shape["OW"], meta["BLOCK_M"]), triton.cdiv(cout, block_n), k)
-    forward_kernel[grid](x, images, w, bias, y, b, **shape, FRAMES=images is not None, BLOCK_N=block_n)
+    forward_kernel[grid](x, w, bias, y, b, **shape, BLOCK_N=block_n)
     return y
 
 
@@ -252,7 +256,7 @@ def _dgrad(dy: torch.Tensor, y: torch.Tensor, w: torch.Tensor, h: int, wd: int, 
     return dx
 
 
-def _wgrad(x: torch.Tensor, images, dy: torch.Tensor, y: torch.Tensor, kh: int, kw: int, stride: int,
+def _wgrad(x: torch.Tensor, dy: torch.Tensor, y: torch.Tensor, kh: int, kw: int, stride: int,
            relu: bool) -> Tuple[torch.Tensor, torch.Tensor]:
     """x as _forward takes it, dy and the output y [K, B, OH, OW, Cout] (the compute dtype) -> dw [K, kh, kw, Cin,
     Cout] and db [K, Cout] in fp32; under `relu`, dy is taken where y > 0 only."""
@@ -264,49 +268,61 @@ def _wgrad(x: torch.Tensor, images, dy: torch.Tensor, y: torch.Tensor, kh: int, 
     bias_parts = torch.empty((k, split, cout), device=x.device, dtype=torch.float32)
     block_n = _width_block(cout)
     grid = lambda meta: (kh * triton.cdiv(kw * cin, meta["BLOCK_D"]), triton.cdiv(cout, block_n), k * split)
-    wgrad_kernel[grid](x, images, dy, y, parts, bias_parts, b, chunk, split,
-                       **_shape_args(*x.shape[-3:-1], kh, kw, cin, cout, stride, relu), FRAMES=images is not None,
-                       BLOCK_N=block_n)
+    wgrad_kernel[grid](x, dy, y, parts, bias_parts, b, chunk, split,
+                       **_shape_args(*x.shape[-3:-1], kh, kw, cin, cout, stride, relu), BLOCK_N=block_n)
     return parts.sum(dim=1), bias_parts.sum(dim=1)
 
 
+def frames_to_blocks(frames: torch.Tensor, images: torch.Tensor, s: int) -> torch.Tensor:
+    """uint8 frames [..., H, W, C] at int64 images [K, B] -> [K, B, H // s, W // s, C * s * s] uint8: run k's
+    b-th frame, frames.reshape(-1, H, W, C)[images[k, b]], cut into s x s blocks whose channel (c, p, q) holds
+    pixel (s * i + p, s * j + q) channel c of block (i, j) (space_to_depth.weight_space_to_depth's order). One
+    pass: the gather and the rearrangement together. Rows and columns past the last whole block are dropped
+    (a convolution whose kernel and stride are multiples of s never reads them)."""
+    h, w, c = frames.shape[-3:]
+    k, b = images.shape
+    blocks = torch.empty((k, b, h // s, w // s, c * s * s), device=frames.device, dtype=torch.uint8)
+    strip = w // s * s * s * c
+    blocks_kernel[(k * b, h // s)](frames, images, blocks, H=h, W=w, C=c, S=s,
+                                   BLOCK=triton.next_power_of_2(strip))
+    return blocks
+
+
 class _PackedConv(torch.autograd.Function):
-    """The unpadded packed convolution, with its ReLU under `relu`, of x [K, B, H, W, Cin] (bf16 or fp32), or
-    of uint8 frames [..., H, W, Cin] at images [K, B] (read as value / 255 in `dtype`), at a stride that divides
-    the kernel;
-    the grouped layout's weight [K * Cout, Cin, kh, kw] and bias [K * Cout] (any float dtype) -> [K, B, OH,
+    """The unpadded packed convolution, with its ReLU under `relu`, of x [K, B, H, W, Cin] (bf16 or fp32, or
+    uint8 read as the integers it holds), at a stride that divides the kernel; the grouped layout's weight [K * Cout, Cin, kh, kw] and bias [K * Cout] (any float dtype) -> [K, B, OH,
     OW, Cout] in `dtype`. The kernels compute in `dtype` with fp32 sums (fp32 master weights arrive as they are
     under autocast: cast here); the gradients come back in their inputs' dtypes. The ReLU is the forward
     kernel's epilogue, and its gradient is applied where the backward kernels read the incoming gradient: no
     pass of its own either way."""
 
     @staticmethod
-    def forward(ctx, x, images, weight, bias, stride, dtype, relu):
-        k = (images if images is not None else x).shape[0]
+    def forward(ctx, x, weight, bias, stride, dtype, relu):
+        k = x.shape[0]
         cin = x.shape[-1]
         cout, kh, kw = weight.shape[0] // k, weight.shape[2], weight.shape[3]
         assert weight.shape[1] == cin and weight.shape[0] == k * cout, (x.shape, weight.shape)
         assert kh % stride == 0 and kw % stride == 0, (weight.shape, stride)
         x = x.contiguous()
         w = weight.reshape(k, cout, cin, kh, kw).permute(0, 3, 4, 2, 1).contiguous().to(dtype)
-        y = _forward(x, images, w, bias.to(torch.float32).contiguous(), stride, relu)
-        ctx.save_for_backward(x, images, w, y)
+        y = _forward(x, w, bias.to(torch.float32).contiguous(), stride, relu)
+        ctx.save_for_backward(x, w, y)
         ctx.stride, ctx.relu, ctx.weight_dtype, ctx.bias_dtype = stride, relu, weight.dtype, bias.dtype
         return y
 
     @staticmethod
     def backward(ctx, dy):
-        x, images, w, y = ctx.saved_tensors
+        x, w, y = ctx.saved_tensors
         k, kh, kw, cin, cout = w.shape
         dy = dy.to(y.dtype).contiguous()
         dx = dw = db = None
         if ctx.needs_input_grad[0]:  # activations only: frames are integers
             dx = _dgrad(dy, y, w, x.shape[2], x.shape[3], ctx.stride, ctx.relu)
-        if ctx.needs_input_grad[2] or ctx.needs_input_grad[3]:
-            dw, db = _wgrad(x, images, dy, y, kh, kw, ctx.stride, ctx.relu)
+        if ctx.needs_input_grad[1] or ctx.needs_input_grad[2]:
+            dw, db = _wgrad(x, dy, y, kh, kw, ctx.stride, ctx.relu)
             dw = dw.permute(0, 4, 3, 1, 2).reshape(k * cout, cin, kh, kw).to(ctx.weight_dtype)
             db = db.reshape(-1).to(ctx.bias_dtype)
-        return dx, None, dw, db, None, None, None
+        return dx, dw, db, None, None, None
 
 
 def packed_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, stride: int = 1,
@@ -315,15 +331,18 @@ def packed_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor, strid
     [K * Cout] as nn.Conv2d(groups=K) holds them -> [K, B, OH, OW, Cout], through a ReLU under `relu`
     (F.relu(packed_conv(...)) without the ReLU's passes). The stride must divide the kernel; the kernels stride
     over x as it lies."""
-    return _PackedConv.apply(x, None, weight, bias, stride, x.dtype, relu)
+    return _PackedConv.apply(x, weight, bias, stride, x.dtype, relu)
 
 
 def packed_conv_frames(frames: torch.Tensor, images: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor,
                        stride: int, dtype: torch.dtype, relu: bool = False) -> torch.Tensor:
-    """packed_conv of K runs' uint8 frames / 255 in `dtype`, read where they are: run k's b-th frame is
-    frames.reshape(-1, H, W, C)[images[k, b]] (the rollout buffer and a minibatch's indices, or a batch
-    [K, B, H, W, C] and torch.arange(K * B).view(K, B)). The kernels stride over the frames directly: no
-    gathered or converted copy is made, and the frames get no gradient."""
+    """packed_conv of K runs' uint8 frames / 255 in `dtype`, where run k's b-th frame is frames.reshape(-1, H,
+    W, C)[images[k, b]] (the rollout buffer and a minibatch's indices, or a batch [K, B, H, W, C] and
+    torch.arange(K * B).view(K, B)). It runs as the equal stride-1 convolution over the frames' stride x stride
+    blocks (frames_to_blocks: one uint8 copy) with the blocks' weight / 255: the kernels read the bytes as exact
+    integers, so the only rounding is the weight's to `dtype`, as autocast's, and not also the frames' / 255.
+    The frames get no gradient."""
     assert frames.dtype == torch.uint8 and images.dtype == torch.int64 and images.dim() == 2, (frames.dtype,
                                                                                                images.shape)
-    return _PackedConv.apply(frames.contiguous(), images.contiguous(), weight, bias, stride, dtype, relu)
+    blocks = frames_to_blocks(frames.contiguous(), images.contiguous(), stride)
+    return _PackedConv.apply(blocks, weight_space_to_depth(weight, stride) / 255.0, bias, 1, dtype, relu)
