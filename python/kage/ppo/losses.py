@@ -55,7 +55,8 @@ def clip_grad_norm_per_run(agent, max_norm: float) -> torch.Tensor:
     """Scales each run's gradients by max_norm / max(norm, max_norm), its norm taken over all its
     parameters (Optax's clip_by_global_norm, §2.1); returns the [K] norms."""
     grads = [agent.run_view(p.grad) for p in agent.parameters()]
-    norm = torch.stack([g.pow(2).sum(tuple(range(1, g.dim()))) for g in grads]).sum(0).sqrt()
+    # Each parameter's per-run norm in one reading pass (no squared copy), then their root sum of squares.
+    norm = torch.stack([torch.linalg.vector_norm(g, dim=tuple(range(1, g.dim()))) for g in grads]).norm(dim=0)
     scale = max_norm / torch.maximum(norm, torch.full_like(norm, max_norm))
     for g in grads:
         g.mul_(scale.view(-1, *[1] * (g.dim() - 1)))

@@ -337,8 +337,9 @@ def load_optimizer(optimizer: torch.optim.Adam, agent, runs: List[dict]) -> None
             continue
         state = {}
         for key, value in runs[0][name].items():
-            if key == "step":
-                state[key] = value.clone() if torch.is_tensor(value) else value
+            if key == "step":  # on the host, except under fused Adam, whose kernel reads it on the device
+                state[key] = (value.to(p.device) if optimizer.defaults.get("fused") else value.clone()) \
+                    if torch.is_tensor(value) else value
             else:
                 state[key] = torch.empty_like(p).copy_(torch.cat([r[name][key] for r in runs]).to(p.device))
         optimizer.state[p] = state

@@ -91,7 +91,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         open_run_dir(run)
     agent_spec = {"agent": args.agent, "observation_shape": [height, width, channels], "num_actions": num_actions,
                   "use_frame_stack": args.use_frame_stack}  # what kage.ppo.evaluate needs to rebuild a run's policy
-    optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5)
+    # On CUDA, Adam's one fused kernel: the same update as the multi-tensor one, one pass over the parameters,
+    # gradients and moments instead of several (the optimizer took 8 % of a packed iteration before).
+    optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5, fused=device.type == "cuda")
     random = CounterRandom([a.seed for a in pack], device)
     counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
     settings = EvalSettings(args.eval_episodes, args.use_frame_stack, args.eval_greedy, args.bf16)

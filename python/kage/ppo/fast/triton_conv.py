@@ -20,17 +20,17 @@ import triton.language as tl
 from kage.ppo.fast.space_to_depth import weight_space_to_depth
 
 # The reduction spans are conv1's 2 x 48 block bytes a filter row, conv2's 4 x 32 (stride 2) and conv3's 3 x 64;
-# outputs are 32/64/64 channels. A program's output tile covers the
-# whole output width (BLOCK_N) in the forward pass and the weight gradient, so the configs tune the rest; the
-# 32-wide ones fit conv1's span and conv2's 32 input channels (its input gradient's width).
+# outputs are 32/64/64 channels. A program's output tile covers the whole output width (BLOCK_N) in the forward
+# pass and the weight gradient, so the configs tune the rest; the input gradient's width is conv2's 2 x 2 x 32
+# and conv3's 64 (a block of input positions), and the weight gradient's 256-tap tile takes all of conv1's 192.
 _FORWARD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_K": k}, num_warps=w, num_stages=s)
                     for m, k, w, s in ((128, 32, 4, 3), (128, 64, 4, 3), (64, 32, 4, 4), (128, 64, 8, 4))]
 _DGRAD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_N": n, "BLOCK_K": k}, num_warps=w, num_stages=s)
                   for m, n, k, w, s in ((128, 64, 32, 4, 3), (128, 128, 32, 8, 3), (64, 64, 64, 4, 4),
-                                        (128, 64, 64, 8, 3), (128, 32, 64, 4, 3))]
+                                        (128, 64, 64, 8, 3), (64, 128, 64, 4, 3))]
 _WGRAD_CONFIGS = [triton.Config({"BLOCK_D": d, "BLOCK_M": m}, num_warps=w, num_stages=s)
                   for d, m, w, s in ((64, 64, 4, 3), (128, 64, 4, 3), (64, 128, 4, 4), (128, 128, 8, 3),
-                                     (32, 128, 4, 4))]
+                                     (256, 64, 8, 3))]
 _SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "STRIDE", "RELU"]
 
 
@@ -105,31 +105,32 @@ def dgrad_kernel(dy_ptr, y_ptr, w_ptr, dx_ptr, B,
                  BLOCK_M: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_K: tl.constexpr):
     """On activations (the frames need no gradient): dx[run, b, ih, iw, ci] = sum over (kh, kw, co) of
     dy[run, b, oh, ow, co] * w[run, kh, kw, ci, co] where ih = S * oh + kh and iw = S * ow + kw, 0 <= oh < OH,
-    0 <= ow < OW. A program owns input positions of one parity (ih % S, iw % S) = (ph, pw), so its taps are
-    the same for all its rows, kh = ph + S * j and kw = pw + S * l, at oh = ih // S - j, ow = iw // S - l:
-    the stride costs no masked work, and dx lands in the input's own layout (no space-to-depth copy, no
-    gradient of one). Under RELU, dy is the gradient after the layer's ReLU: each element counts where the
-    output y there is positive (ReLU's gradient, read where dy is read instead of in a pass of its own)."""
-    HC: tl.constexpr = (H + STRIDE - 1) // STRIDE  # positions of one parity along a column and a row
-    WC: tl.constexpr = (W + STRIDE - 1) // STRIDE
+    0 <= ow < OW. A row is one S x S block of input positions (bh, bw) and a column one (ph, pw, ci) of it,
+    ih = S * bh + ph, iw = S * bw + pw: every position of the block meets the same outputs, oh = bh - j and
+    ow = bw - l for the taps kh = ph + S * j, kw = pw + S * l, so one load of dy per (j, l) serves all of the
+    block's S * S positions (the stride costs no masked work and no re-reading), and dx lands in the input's
+    own layout (no space-to-depth copy, no gradient of one). Under RELU, dy is the gradient after the layer's
+    ReLU: each element counts where the output y there is positive (ReLU's gradient, read where dy is read
+    instead of in a pass of its own)."""
+    HB: tl.constexpr = (H + STRIDE - 1) // STRIDE  # blocks along a column and a row
+    WB: tl.constexpr = (W + STRIDE - 1) // STRIDE
     TAPS_H: tl.constexpr = KH // STRIDE
     TAPS_W: tl.constexpr = KW // STRIDE
     STEPS: tl.constexpr = (COUT + BLOCK_K - 1) // BLOCK_K
-    COL_BLOCKS: tl.constexpr = (CIN + BLOCK_N - 1) // BLOCK_N
     run = tl.program_id(2).to(tl.int64)
-    parity = tl.program_id(1) // COL_BLOCKS
-    ph = parity // STRIDE
-    pw = parity % STRIDE
     rows = tl.program_id(0) * BLOCK_M + tl.arange(0, BLOCK_M)
-    cols = tl.program_id(1) % COL_BLOCKS * BLOCK_N + tl.arange(0, BLOCK_N)
-    b = rows // (HC * WC)
-    ih = rows // WC % HC * STRIDE + ph
-    iw = rows % WC * STRIDE + pw
-    row_ok = (rows < B * (HC * WC)) & (ih < H) & (iw < W)
-    col_ok = cols < CIN
-    # dy's offset of (b, ih // S, iw // S) as if that output position existed; tap (j, l) reads j * OW + l
-    # positions before it, wherever the mask allows.
-    dy_row = ((b * OH + ih // STRIDE) * OW + iw // STRIDE).to(tl.int64) * COUT
+    cols = tl.program_id(1) * BLOCK_N + tl.arange(0, BLOCK_N)
+    b = rows // (HB * WB)
+    bh = rows // WB % HB
+    bw = rows % WB
+    row_ok = rows < B * (HB * WB)
+    ci = cols % CIN
+    ph = cols // CIN // STRIDE
+    pw = cols // CIN % STRIDE
+    col_ok = cols < STRIDE * STRIDE * CIN
+    # dy's offset of (b, bh, bw) as if that output position existed; tap (j, l) reads j * OW + l positions
+    # before it, wherever the mask allows.
+    dy_row = ((b * OH + bh) * OW + bw).to(tl.int64) * COUT
     dy_run = dy_ptr + (run * B) * (OH * OW * COUT)
     y_run = y_ptr + (run * B) * (OH * OW * COUT)
     w_run = w_ptr + run * (KH * KW * CIN * COUT)
@@ -139,22 +140,22 @@ def dgrad_kernel(dy_ptr, y_ptr, w_ptr, dx_ptr, B,
         l = step // STEPS % TAPS_W
         chans = step % STEPS * BLOCK_K + tl.arange(0, BLOCK_K)
         chan_ok = chans < COUT
-        oh = ih // STRIDE - j
-        ow = iw // STRIDE - l
-        tap_ok = row_ok & (oh >= 0) & (oh < OH) & (ow >= 0) & (ow < OW)
+        tap_ok = row_ok & (bh - j >= 0) & (bh - j < OH) & (bw - l >= 0) & (bw - l < OW)
         at = dy_row[:, None] + (chans - (j * OW + l) * COUT)[None, :]
         grad = tl.load(dy_run + at, mask=tap_ok[:, None] & chan_ok[None, :], other=0.0)
         if RELU:
             positive = tl.load(y_run + at, mask=tap_ok[:, None] & chan_ok[None, :], other=0.0) > 0
             grad = tl.where(positive, grad, tl.zeros_like(grad))
         tap = (ph + STRIDE * j) * KW + pw + STRIDE * l
-        weight = tl.load(w_run + ((tap * CIN + cols)[None, :] * COUT + chans[:, None]),
+        weight = tl.load(w_run + ((tap * CIN + ci)[None, :] * COUT + chans[:, None]),
                          mask=chan_ok[:, None] & col_ok[None, :], other=0.0)
         acc += tl.dot(grad, weight)
-    dx_row = ((b * H + ih) * W + iw).to(tl.int64) * CIN
+    ih = bh[:, None] * STRIDE + ph[None, :]
+    iw = bw[:, None] * STRIDE + pw[None, :]
+    dx_at = ((b[:, None] * H + ih) * W + iw).to(tl.int64) * CIN + ci[None, :]
     dx_run = dx_ptr + (run * B) * (H * W * CIN)
-    tl.store(dx_run + (dx_row[:, None] + cols[None, :]), acc.to(dx_ptr.dtype.element_ty),
-             mask=row_ok[:, None] & col_ok[None, :])
+    tl.store(dx_run + dx_at, acc.to(dx_ptr.dtype.element_ty),
+             mask=row_ok[:, None] & col_ok[None, :] & (ih < H) & (iw < W))
 
 
 @triton.autotune(configs=_WGRAD_CONFIGS, key=_SHAPE_KEY)
@@ -166,15 +167,16 @@ def wgrad_kernel(x_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLI
                  BLOCK_D: tl.constexpr, BLOCK_N: tl.constexpr, BLOCK_M: tl.constexpr):
     """parts[run, part, kh, kw, ci, co] = sum over m in the part's CHUNK rows of x[image, S * oh + kh, S * ow +
     kw, ci] * dy[run, m, co] (the image and x's reading as in forward_kernel), and bias_parts[run, part, co] =
-    the sum of those dy[run, m, co]. A program owns BLOCK_D
-    contiguous (kw, ci) pairs of one kh (axis 0), BLOCK_N output channels (axis 1) and one (run, part) (axis 2):
+    the sum of those dy[run, m, co]. A program owns BLOCK_D of the KH * KW * CIN filter taps (kh, kw, ci) in
+    their flat order (axis 0; as few blocks as possible, since each re-reads dy and y), BLOCK_N output channels
+    (axis 1) and one (run, part) (axis 2):
     SPLIT parts per run spread M's up to 2 M rows over the GPU, each writing fp32 partial sums that the caller
     adds up; the programs of the first (kh, kw, ci) block also sum dy for the bias, on the tiles they load
     anyway. Under RELU, dy counts where the output y is positive (as in dgrad_kernel)."""
-    STEPS: tl.constexpr = (KW * CIN + BLOCK_D - 1) // BLOCK_D
-    kh = tl.program_id(0) // STEPS
-    span = tl.program_id(0) % STEPS * BLOCK_D + tl.arange(0, BLOCK_D)
-    span_ok = span < KW * CIN
+    taps = tl.program_id(0) * BLOCK_D + tl.arange(0, BLOCK_D)
+    taps_ok = taps < KH * KW * CIN
+    # A tap's offset from an output position's top-left input element: row kh, then KW * CIN contiguous.
+    tap_at = taps // (KW * CIN) * (W * CIN) + taps % (KW * CIN)
     cols = tl.program_id(1) * BLOCK_N + tl.arange(0, BLOCK_N)
     col_ok = cols < COUT
     run = (tl.program_id(2) // SPLIT).to(tl.int64)
@@ -182,7 +184,6 @@ def wgrad_kernel(x_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLI
     m_total = B * (OH * OW)
     start = part * CHUNK
     end = tl.minimum(start + CHUNK, m_total)
-    x_kh = x_ptr + kh * (W * CIN)
     dy_run = dy_ptr + (run * B) * (OH * OW * COUT)
     y_run = y_ptr + (run * B) * (OH * OW * COUT)
     sums_bias = tl.program_id(0) == 0
@@ -195,7 +196,7 @@ def wgrad_kernel(x_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLI
         oh = rows // OW % OH
         ow = rows % OW
         x_row = (((run * B + b) * H + oh * STRIDE) * W + ow * STRIDE) * CIN
-        patch = tl.load(x_kh + (x_row[:, None] + span[None, :]), mask=row_ok[:, None] & span_ok[None, :],
+        patch = tl.load(x_ptr + (x_row[:, None] + tap_at[None, :]), mask=row_ok[:, None] & taps_ok[None, :],
                         other=0).to(dy_ptr.dtype.element_ty)
         at = rows.to(tl.int64)[:, None] * COUT + cols[None, :]
         grad = tl.load(dy_run + at, mask=row_ok[:, None] & col_ok[None, :], other=0.0)
@@ -206,8 +207,7 @@ def wgrad_kernel(x_ptr, dy_ptr, y_ptr, parts_ptr, bias_parts_ptr, B, CHUNK, SPLI
         if sums_bias:
             bias_acc += tl.sum(grad.to(tl.float32), axis=0)
     parts_run = parts_ptr + tl.program_id(2).to(tl.int64) * (KH * KW * CIN * COUT)
-    tl.store(parts_run + ((kh * (KW * CIN) + span)[:, None] * COUT + cols[None, :]), acc,
-             mask=span_ok[:, None] & col_ok[None, :])
+    tl.store(parts_run + (taps[:, None] * COUT + cols[None, :]), acc, mask=taps_ok[:, None] & col_ok[None, :])
     if sums_bias:
         tl.store(bias_parts_ptr + tl.program_id(2).to(tl.int64) * COUT + cols, bias_acc, mask=col_ok)
 
@@ -249,9 +249,8 @@ def _dgrad(dy: torch.Tensor, y: torch.Tensor, w: torch.Tensor, h: int, wd: int, 
     k, b, _, _, cout = dy.shape
     _, kh, kw, cin, _ = w.shape
     dx = torch.empty((k, b, h, wd, cin), device=dy.device, dtype=dy.dtype)
-    parity_rows = b * triton.cdiv(h, stride) * triton.cdiv(wd, stride)  # input positions of one parity
-    grid = lambda meta: (triton.cdiv(parity_rows, meta["BLOCK_M"]),
-                         stride * stride * triton.cdiv(cin, meta["BLOCK_N"]), k)
+    blocks = b * triton.cdiv(h, stride) * triton.cdiv(wd, stride)  # stride x stride blocks of input positions
+    grid = lambda meta: (triton.cdiv(blocks, meta["BLOCK_M"]), triton.cdiv(stride * stride * cin, meta["BLOCK_N"]), k)
     dgrad_kernel[grid](dy, y, w, dx, b, **_shape_args(h, wd, kh, kw, cin, cout, stride, relu))
     return dx
 
@@ -267,7 +266,7 @@ def _wgrad(x: torch.Tensor, dy: torch.Tensor, y: torch.Tensor, kh: int, kw: int,
     parts = torch.empty((k, split, kh, kw, cin, cout), device=x.device, dtype=torch.float32)
     bias_parts = torch.empty((k, split, cout), device=x.device, dtype=torch.float32)
     block_n = _width_block(cout)
-    grid = lambda meta: (kh * triton.cdiv(kw * cin, meta["BLOCK_D"]), triton.cdiv(cout, block_n), k * split)
+    grid = lambda meta: (triton.cdiv(kh * kw * cin, meta["BLOCK_D"]), triton.cdiv(cout, block_n), k * split)
     wgrad_kernel[grid](x, dy, y, parts, bias_parts, b, chunk, split,
                        **_shape_args(*x.shape[-3:-1], kh, kw, cin, cout, stride, relu), BLOCK_N=block_n)
     return parts.sum(dim=1), bias_parts.sum(dim=1)
