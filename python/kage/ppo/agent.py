@@ -42,7 +42,8 @@ class Agent(nn.Module):
         self.conv2 = nn.Conv2d(k * 32, k * 64, 4, stride=2, groups=k, device=device)
         self.conv3 = nn.Conv2d(k * 64, k * 64, 3, stride=1, groups=k, device=device)
         conv_h, conv_w = ((height - 8) // 4 + 1 - 4) // 2 + 1 - 2, ((width - 8) // 4 + 1 - 4) // 2 + 1 - 2
-        self.flat = 64 * conv_h * conv_w
+        self.conv3_positions = conv_h * conv_w
+        self.flat = 64 * self.conv3_positions
         self.fc_weight = nn.Parameter(torch.empty(k, self.flat, 512, device=device))
         self.fc_bias = nn.Parameter(torch.zeros(k, 1, 512, device=device))
         self.actor_weight = nn.Parameter(torch.empty(k, 512, num_actions, device=device))
@@ -53,6 +54,7 @@ class Agent(nn.Module):
         # The torso's one implementation for this network: cuDNN on the frames, cuDNN on 4x4 blocks (--fused-input),
         # or kage.ppo.fast.triton_conv's kernels on 4x4 blocks (--triton-conv, which needs --fused-input).
         self._torso = self._torso_triton if triton_conv else self._torso_blocks if fused_input else self._torso_frames
+        self._fc_weight = self._fc_weight_positions_first if triton_conv else lambda: self.fc_weight
         with torch.no_grad():
             for run, seed in enumerate(seeds):
                 self._initialise(run, seed, channels)
@@ -77,7 +79,7 @@ class Agent(nn.Module):
         b-th frame is obs.reshape(-1, H, W, C)[images[k, b]] (a minibatch of the rollout buffer: --triton-conv
         reads it there, the other torsos gather it). The first operation is the conversion to float32 divided
         by 255 (§1.1); the runs' frames meet as channel groups (under --triton-conv as a batch index)."""
-        hidden = F.relu(torch.baddbmm(self.fc_bias, self._torso(obs, images), self.fc_weight))
+        hidden = F.relu(torch.baddbmm(self.fc_bias, self._torso(obs, images), self._fc_weight()))
         # The heads always in float32, even under --bf16: values reach thousands (an untrained episode
         # returns about -3,900), where bfloat16's spacing is 16, more than a step's reward; rounded values
         # would bury the advantages in noise.
@@ -132,7 +134,7 @@ class Agent(nn.Module):
         """The three convolutions on kage.ppo.fast.triton_conv's kernels (--triton-conv): the runs as a batch index
         instead of channel groups, activations [K, B, H, W, C], the same parameters; conv1 on the minibatch's
         uint8 frames gathered into 4 x 4 blocks, the 1 / 255 in its weight. Returns [K, B, flat] in each run's
-        (channel, row, column) order."""
+        (row, column, channel) order, as conv3's kernel stores it (_fc_weight_positions_first matches it)."""
         from kage.ppo.fast import triton_conv  # here, not at the top: triton is needed only under the flag
         if images is None:
             images = torch.arange(obs.shape[0] * obs.shape[1], device=obs.device).view(obs.shape[:2])
@@ -141,7 +143,17 @@ class Agent(nn.Module):
                                            relu=True)
         x = triton_conv.packed_conv(x, self.conv2.weight, self.conv2.bias, stride=2, relu=True)
         x = triton_conv.packed_conv(x, self.conv3.weight, self.conv3.bias, relu=True)
-        return x.permute(0, 1, 4, 2, 3).reshape(k, b, self.flat)
+        return x.reshape(k, b, self.flat)
+
+    def _fc_weight_positions_first(self) -> torch.Tensor:
+        """fc_weight [K, flat, 512] with its rows in the (row, column, channel) order of _torso_triton's output,
+        in the compute dtype: the parameter keeps each run's (channel, row, column) flatten order (checkpoints
+        do not change), and this one copy of the weight, which is also the cast that autocast would make,
+        replaces a copy of the activations forward and another of their gradient backward."""
+        k, _, units = self.fc_weight.shape
+        rows = self.fc_weight.view(k, 64, self.conv3_positions, units).transpose(1, 2)
+        copy = torch.empty(rows.shape, dtype=self.input_dtype, device=rows.device).copy_(rows)  # one pass
+        return copy.view(k, self.flat, units)
 
     def run_view(self, tensor: torch.Tensor) -> torch.Tensor:
         """A tensor shaped like a parameter (the parameter, its gradient, an Adam moment) as [K, ...]: the
