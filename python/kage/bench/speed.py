@@ -9,7 +9,7 @@ pair (seeds 1..K) for a few iterations after a warm-up, then evaluates once, and
   (gradient clipping and Adam), measured with CUDA events (CPU clocks on the CPU), and the rest;
 - the time of one evaluation point (128 episodes on each of the two configs, per run);
 - the projected wall time of a pack through a full run (1,525 iterations and 32 evaluation points), per
-  run, and for the 340-run table.
+  run, and for the 340-run table, and the aggregate steps/s of that full run (evaluations counted).
 This is a benchmark command, not a test: its numbers depend on the machine (record them under
 bench/results/ with the GPU and the date).
 """
@@ -104,6 +104,7 @@ def measure(base: train.Args, packs: int, warmup: int, iterations: int, workdir:
     eval_point = timer.eval_seconds[-1]  # the final one: warm
     full_run = base.num_iterations * iteration + 32 * eval_point  # a 25 M-step run has 32 evaluation points
     return {"K": packs, "steps_per_s": packs * base.batch_size / iteration, "iteration_s": iteration,
+            "steps_per_s_with_evals": packs * base.batch_size * base.num_iterations / full_run,
             "shares": shares, "eval_point_s": eval_point, "first_eval_point_s": timer.eval_seconds[0],
             "full_run_hours": full_run / 3600, "gpu_hours_per_run": full_run / 3600 / packs,
             "table_gpu_hours": 340 * full_run / 3600 / packs, "command_wall_s": wall,
@@ -126,8 +127,8 @@ def main(argv: List[str]) -> int:
     print(f"kage.bench speed: {torch.cuda.get_device_name() if base.device == 'cuda' else 'cpu'}, torch "
           f"{torch.__version__}, {flags}", flush=True)
     print("| K | steps/s | iteration s | env | forward | update fwd | backward | optimizer | other | eval point s "
-          "| full run h (wall, per pack) | GPU h per run | 340 runs GPU h | peak GiB |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
+          "| full run h (wall, per pack) | steps/s with evals | GPU h per run | 340 runs GPU h | peak GiB |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     with tempfile.TemporaryDirectory() as workdir:
         for packs in [int(k) for k in args.packs.split(",")]:
             try:
@@ -139,7 +140,8 @@ def main(argv: List[str]) -> int:
             s = r["shares"]
             print(f"| {packs} | {r['steps_per_s']:,.0f} | {r['iteration_s']:.3f} | "
                   + " | ".join(f"{100 * s[p]:.0f} %" for p in PHASES + ("other",))
-                  + f" | {r['eval_point_s']:.2f} | {r['full_run_hours']:.2f} | {r['gpu_hours_per_run']:.3f} | "
+                  + f" | {r['eval_point_s']:.2f} | {r['full_run_hours']:.2f} | {r['steps_per_s_with_evals']:,.0f} | "
+                  f"{r['gpu_hours_per_run']:.3f} | "
                   f"{r['table_gpu_hours']:.1f} | {r['max_memory_gib'] or 0:.1f} |", flush=True)
             if args.json:
                 with open(args.json, "a") as f:
