@@ -1,0 +1,64 @@
+"""Packs one finished task of a benchmark directory for the trip home from a device machine: the task's run
+folders (metrics, summaries, configs, certificates, TensorBoard events, logs; never checkpoints) with the
+directory's bench.json, suite.json, tasks.json and the task's pack logs, as DEST/task_I.tar.gz (paths relative
+to DIR, so the archives of all tasks unpack into one benchmark directory), and DEST/task_I.sha256: the archive's
+checksum, then each packed file's. Refuses, naming the runs, while any run of the task has no summary.json.
+
+usage: python3 lab/tools/pack_task.py DIR TASK DEST"""
+import hashlib
+import json
+import os
+import sys
+import tarfile
+
+TOP = ("bench.json", "suite.json", "tasks.json")
+
+
+def sha256(path: str) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def task_files(root: str, task: int) -> list:
+    """The files to pack, relative to root; exits naming the unfinished runs if any."""
+    with open(os.path.join(root, "tasks.json")) as f:
+        table = json.load(f)["tasks"]
+    if not 0 <= task < len(table):
+        sys.exit(f"pack_task: {root}/tasks.json has tasks 0 to {len(table) - 1}, not {task}")
+    runs = [os.path.join("runs", job["unit"], f"seed_{job['seed']}") for job in table[task]]
+    unfinished = [r for r in runs if not os.path.exists(os.path.join(root, r, "summary.json"))]
+    if unfinished:
+        sys.exit(f"pack_task: task {task} is not finished: no summary.json in {', '.join(unfinished)}")
+    files = [name for name in TOP if os.path.exists(os.path.join(root, name))]
+    packs = os.path.join(root, "packs")
+    if os.path.isdir(packs):
+        files += [os.path.join("packs", n) for n in sorted(os.listdir(packs)) if n.startswith(f"task_{task}_")]
+    for run in runs:
+        for folder, dirs, names in os.walk(os.path.join(root, run)):
+            dirs[:] = sorted(d for d in dirs if d != "checkpoints")
+            files += [os.path.relpath(os.path.join(folder, n), root) for n in sorted(names)]
+    return files
+
+
+def main() -> None:
+    if len(sys.argv) != 4:
+        sys.exit(__doc__.splitlines()[-1])
+    root, task, dest = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+    files = task_files(root, task)
+    os.makedirs(dest, exist_ok=True)
+    archive = os.path.join(dest, f"task_{task}.tar.gz")
+    with tarfile.open(archive + ".part", "w:gz") as tar:
+        for name in files:
+            tar.add(os.path.join(root, name), arcname=name)
+    os.replace(archive + ".part", archive)  # a killed call leaves no archive that looks whole
+    with open(os.path.join(dest, f"task_{task}.sha256"), "w") as f:
+        f.write(f"{sha256(archive)}  task_{task}.tar.gz\n")
+        f.writelines(f"{sha256(os.path.join(root, n))}  {n}\n" for n in files)
+    print(f"pack_task: task {task}: {len(files)} files, {os.path.getsize(archive) / 1e6:.1f} MB in {archive}")
+
+
+if __name__ == "__main__":
+    main()
