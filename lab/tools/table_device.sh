@@ -17,10 +17,10 @@ DIR=${DIR:-/tmp/kage-table}
 LIMIT=${LIMIT:-570}
 FLAGS=${FLAGS:---bf16 --fused-input --cuda-graph --triton-conv}
 export TRITON_CACHE_DIR=${TRITON_CACHE_DIR:-/tmp/kage-triton-cache}  # compiled kernels kept for the lease
-left=$((LIMIT - SECONDS - 40))  # 40 s to stop (SIGTERM: checkpoint), pack and copy out
+left=$((LIMIT - SECONDS - 90))  # 90 s to stop (SIGTERM ends the iteration or evaluation point, then checkpoints) and pack
 if [ "$left" -gt 60 ]; then
   # shellcheck disable=SC2086
-  timeout --signal=TERM --kill-after=20 "$left" python3 -m kage.bench run kage_bench --seeds 1-10 --share-training \
+  timeout --signal=TERM --kill-after=60 "$left" python3 -m kage.bench run kage_bench --seeds 1-10 --share-training \
     --pack "$PACK" --task "$TASK" --out "$DIR" $FLAGS 2>&1 | grep -v '^iteration' | tail -15
 fi
 python3 -m kage.bench status "$DIR" 2>&1 | tail -15
