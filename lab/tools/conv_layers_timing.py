@@ -3,12 +3,11 @@ minibatch of B frames each, in bf16, the ReLU fused as the trainer runs them (co
 gathered from shuffled indices of a rollout buffer twice the minibatch, the gather timed too), with the TFLOP/s each reaches and the config the
 autotuner chose; beside them cuDNN's grouped channels-last convolution of the same shapes (conv1 on the 4 x 4
 space-to-depth frames, as --fused-input runs it). Finds which kernel bounds the update before a full
-`kage.bench speed` run. MODULE names another file of the same kernels to compare (a path).
+`kage.bench speed` run.
 
-usage: python3 lab/tools/conv_layers_timing.py [--packs 16] [--minibatch 2048] [--module PATH ...]
+usage: python3 lab/tools/conv_layers_timing.py [--packs 16] [--minibatch 2048] [--cudnn]
 """
 import argparse
-import importlib.util
 
 import torch
 import torch.nn.functional as F
@@ -17,16 +16,6 @@ from cuda_timing import median_ms
 
 # (name, input side, in channels, out channels, kernel, stride), NatureCNN on 128 x 128 x 3 frames.
 LAYERS = [("conv1", 128, 3, 32, 8, 4), ("conv2", 31, 32, 64, 4, 2), ("conv3", 14, 64, 64, 3, 1)]
-
-
-def load(path):
-    if path is None:
-        from kage.ppo.fast import triton_conv
-        return triton_conv
-    spec = importlib.util.spec_from_file_location("variant_triton_conv", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def best(kernel) -> str:
@@ -87,14 +76,13 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--packs", type=int, default=16)
     p.add_argument("--minibatch", type=int, default=2048)
-    p.add_argument("--module", nargs="*", default=[None], help="triton_conv files to time (default: the package's)")
     p.add_argument("--cudnn", action="store_true", help="also time cuDNN's grouped convolutions")
     a = p.parse_args()
     torch.backends.cudnn.benchmark = True
     print(f"{torch.cuda.get_device_name()}, torch {torch.__version__}, K = {a.packs}, minibatch {a.minibatch}, bf16")
-    for path in a.module:
-        print(f"\n{path or 'kage.ppo.fast.triton_conv'}\n| layer | pass | ms | TFLOP/s | config |\n|---|---|---|---|---|")
-        time_triton(load(path), a.packs, a.minibatch)
+    from kage.ppo.fast import triton_conv
+    print("\nkage.ppo.fast.triton_conv\n| layer | pass | ms | TFLOP/s | config |\n|---|---|---|---|---|")
+    time_triton(triton_conv, a.packs, a.minibatch)
     if a.cudnn:
         print("\ncuDNN\n| layer | pass | ms | TFLOP/s | config |\n|---|---|---|---|---|")
         time_cudnn(a.packs, a.minibatch)

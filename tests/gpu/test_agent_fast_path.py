@@ -5,15 +5,12 @@ rollout buffer. The logits, the values and every parameter's gradient must be as
 the same network under --bf16 alone (cuDNN under bf16 autocast) are, within SLACK: the fast path changes no
 more than bf16 autocast already does. Errors are max |got - want| / max |want|; each is printed."""
 import torch
+from test_triton_conv import relative_error
 
 from kage.ppo.agent import Agent
 from kage.ppo.policy import autocast
 
 SLACK = 1.5  # whole-network errors compound each layer's rounding, which the per-layer test bounds by 1.1
-
-
-def relative_error(got: torch.Tensor, want: torch.Tensor) -> float:
-    return ((got.float() - want.float()).abs().max() / want.float().abs().max().clamp_min(1e-30)).item()
 
 
 def outputs(agent, inputs, bf16: bool, weights):

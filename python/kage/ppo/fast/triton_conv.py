@@ -22,15 +22,15 @@ from kage.ppo.fast.space_to_depth import weight_space_to_depth
 # The reduction spans are conv1's 2 x 48 block bytes a filter row, conv2's 4 x 32 (stride 2) and conv3's 3 x 64;
 # outputs are 32/64/64 channels. A program's output tile covers the whole output width (BLOCK_N) in the forward
 # pass and the weight gradient, so the configs tune the rest; the input gradient's width is conv2's 2 x 2 x 32
-# and conv3's 64 (a block of input positions), and the weight gradient's 256-tap tile takes all of conv1's 192.
+# and conv3's 64 (a block of input positions). (A 256-tap weight-gradient tile, all of conv1's 192 taps at once,
+# was never chosen on an H100: lab/2026-11-26-h100-conv-kernels.)
 _FORWARD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_K": k}, num_warps=w, num_stages=s)
                     for m, k, w, s in ((128, 32, 4, 3), (128, 64, 4, 3), (64, 32, 4, 4), (128, 64, 8, 4))]
 _DGRAD_CONFIGS = [triton.Config({"BLOCK_M": m, "BLOCK_N": n, "BLOCK_K": k}, num_warps=w, num_stages=s)
                   for m, n, k, w, s in ((128, 64, 32, 4, 3), (128, 128, 32, 8, 3), (64, 64, 64, 4, 4),
                                         (128, 64, 64, 8, 3), (64, 128, 64, 4, 3))]
 _WGRAD_CONFIGS = [triton.Config({"BLOCK_D": d, "BLOCK_M": m}, num_warps=w, num_stages=s)
-                  for d, m, w, s in ((64, 64, 4, 3), (128, 64, 4, 3), (64, 128, 4, 4), (128, 128, 8, 3),
-                                     (256, 64, 8, 3))]
+                  for d, m, w, s in ((64, 64, 4, 3), (128, 64, 4, 3), (64, 128, 4, 4), (128, 128, 8, 3))]
 _SHAPE_KEY = ["B", "H", "W", "CIN", "COUT", "KH", "KW", "STRIDE", "RELU"]
 
 
