@@ -3,8 +3,10 @@ folders (metrics, summaries, configs, certificates, TensorBoard events, logs; ne
 directory's bench.json, suite.json, tasks.json and the task's pack logs, as DEST/task_I.tar.gz (paths relative
 to DIR, so the archives of all tasks unpack into one benchmark directory), and DEST/task_I.sha256: the archive's
 checksum, then each packed file's. Refuses, naming the runs, while any run of the task has no summary.json.
+TASK `new` packs every finished task that this DIR has not packed before (DIR/packed/task_I marks it), for a
+runner of all tasks (`kage.bench run --gpus`) whose tasks finish while it runs.
 
-usage: python3 lab/tools/pack_task.py DIR TASK DEST"""
+usage: python3 lab/tools/pack_task.py DIR TASK|new DEST"""
 import hashlib
 import json
 import os
@@ -22,14 +24,26 @@ def sha256(path: str) -> str:
     return digest.hexdigest()
 
 
+def task_table(root: str) -> list:
+    with open(os.path.join(root, "tasks.json")) as f:
+        return json.load(f)["tasks"]
+
+
+def task_runs(table: list, task: int) -> list:
+    return [os.path.join("runs", job["unit"], f"seed_{job['seed']}") for job in table[task]]
+
+
+def unfinished_runs(root: str, runs: list) -> list:
+    return [r for r in runs if not os.path.exists(os.path.join(root, r, "summary.json"))]
+
+
 def task_files(root: str, task: int) -> list:
     """The files to pack, relative to root; exits naming the unfinished runs if any."""
-    with open(os.path.join(root, "tasks.json")) as f:
-        table = json.load(f)["tasks"]
+    table = task_table(root)
     if not 0 <= task < len(table):
         sys.exit(f"pack_task: {root}/tasks.json has tasks 0 to {len(table) - 1}, not {task}")
-    runs = [os.path.join("runs", job["unit"], f"seed_{job['seed']}") for job in table[task]]
-    unfinished = [r for r in runs if not os.path.exists(os.path.join(root, r, "summary.json"))]
+    runs = task_runs(table, task)
+    unfinished = unfinished_runs(root, runs)
     if unfinished:
         sys.exit(f"pack_task: task {task} is not finished: no summary.json in {', '.join(unfinished)}")
     files = [name for name in TOP if os.path.exists(os.path.join(root, name))]
@@ -43,21 +57,41 @@ def task_files(root: str, task: int) -> list:
     return files
 
 
-def main() -> None:
-    if len(sys.argv) != 4:
-        sys.exit(__doc__.splitlines()[-1])
-    root, task, dest = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+def pack(root: str, task: int, dest: str) -> None:
     files = task_files(root, task)
     os.makedirs(dest, exist_ok=True)
     archive = os.path.join(dest, f"task_{task}.tar.gz")
     with tarfile.open(archive + ".part", "w:gz") as tar:
         for name in files:
             tar.add(os.path.join(root, name), arcname=name)
-    os.replace(archive + ".part", archive)  # a killed call leaves no archive that looks whole
     with open(os.path.join(dest, f"task_{task}.sha256"), "w") as f:
-        f.write(f"{sha256(archive)}  task_{task}.tar.gz\n")
+        f.write(f"{sha256(archive + '.part')}  task_{task}.tar.gz\n")
         f.writelines(f"{sha256(os.path.join(root, n))}  {n}\n" for n in files)
+    os.replace(archive + ".part", archive)  # last: a killed call leaves no archive that looks whole
     print(f"pack_task: task {task}: {len(files)} files, {os.path.getsize(archive) / 1e6:.1f} MB in {archive}")
+
+
+def pack_new(root: str, dest: str) -> None:
+    if not os.path.exists(os.path.join(root, "tasks.json")):
+        return  # the runner has not written its task table yet
+    table = task_table(root)
+    marks = os.path.join(root, "packed")
+    os.makedirs(marks, exist_ok=True)
+    for task in range(len(table)):
+        mark = os.path.join(marks, f"task_{task}")
+        if not os.path.exists(mark) and not unfinished_runs(root, task_runs(table, task)):
+            pack(root, task, dest)
+            open(mark, "w").close()
+
+
+def main() -> None:
+    if len(sys.argv) != 4:
+        sys.exit(__doc__.splitlines()[-1])
+    root, task, dest = sys.argv[1:]
+    if task == "new":
+        pack_new(root, dest)
+    else:
+        pack(root, int(task), dest)
 
 
 if __name__ == "__main__":
