@@ -1,9 +1,10 @@
-"""A diverged run's non-finite losses are logged as null with one warning, instead of ending the process
-(and with it every run of its pack)."""
+"""A run's non-finite losses are logged as null with one warning, in metrics.jsonl and TensorBoard, instead
+of ending the process (and with it every run of its pack)."""
 import json
 import math
 
 from kage.ppo.rundir import RunDir
+from kage.ppo.tensorboard_log import Board, summary_writer_class
 from kage.util.lock import DirectoryLock
 
 
@@ -18,4 +19,18 @@ def test_non_finite_values_are_logged_as_null(tmp_path, capsys):
     assert rows[1] == {"kind": "train", "iteration": 8, "losses/loss": None, "losses/entropy": 0.25}
     warnings = capsys.readouterr().err.splitlines()
     assert warnings == [f"kage.ppo.train: warning: {tmp_path}: losses/loss, losses/value_loss not finite at "
-                        "iteration 7: the run has diverged; such values are logged as null"]
+                        "iteration 7; such values are logged as null"]
+
+
+def test_a_null_loss_reaches_tensorboard_as_nan(tmp_path):
+    """A collapsed run logged approx_kl as null at iteration 1187 of 25 M steps, and the TensorBoard writer's
+    float(None) ended its pack of six."""
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+    board = Board(str(tmp_path), summary_writer_class(), "train", {})
+    board.write({"kind": "train", "iteration": 1187, "global_step": 4096, "losses/approx_kl": None,
+                 "losses/loss": 349.5})
+    board.close()
+    events = EventAccumulator(str(tmp_path))
+    events.Reload()
+    assert math.isnan(events.Scalars("losses/approx_kl")[0].value)
+    assert events.Scalars("losses/loss")[0].value == 349.5

@@ -140,8 +140,9 @@ class RunDir:
 
     def log(self, row: dict) -> dict:
         """Appends one row to metrics.jsonl, flushed and synced; returns it. A value that is not finite (a
-        diverged run's losses) is written as null, with a warning the first time: the run's log stays
-        valid JSON, and the other runs of its pack go on."""
+        diverged run's losses, or approx_kl where a collapsed policy's probability ratio overflows) is
+        written as null, with a warning the first time: the run's log stays valid JSON, and the other runs
+        of its pack go on."""
         self._check_still_held()
         if self._log is None:
             self._log = open(os.path.join(self.path, "metrics.jsonl"), "ab")
@@ -150,7 +151,7 @@ class RunDir:
             row = {k: None if k in bad else v for k, v in row.items()}
             if not self._warned_not_finite:
                 print(f"kage.ppo.train: warning: {self.path}: {', '.join(bad)} not finite at iteration "
-                      f"{row.get('iteration')}: the run has diverged; such values are logged as null",
+                      f"{row.get('iteration')}; such values are logged as null",
                       file=sys.stderr, flush=True)
                 self._warned_not_finite = True
         line = (json.dumps(row, sort_keys=True, allow_nan=False) + "\n").encode()

@@ -16,14 +16,15 @@ MAIN_DIFFS = ("progress", "success_once", "passed_distance", "jump_count")  # co
 
 
 def number(value: Optional[float]) -> float:
-    """A logged value; a missing one (every listed return exactly 0) is NaN, as the original logs it."""
+    """A logged value; a missing one (every listed return exactly 0, or a loss that was not finite) is NaN,
+    as the original logs it."""
     return math.nan if value is None else float(value)
 
 
 def train_scalars(row: dict) -> Dict[str, float]:
     """A training row's tags: its keys are already the original's (charts/, losses/, train/), plus
     charts/global_step and the main_metrics/ copies."""
-    tags = {k: float(v) for k, v in row.items() if "/" in k}
+    tags = {k: number(v) for k, v in row.items() if "/" in k}
     tags["charts/global_step"] = float(row["global_step"])
     tags.update({copy: tags[tag] for tag, copy in TRAIN_COPIES.items() if tag in tags})
     return tags
