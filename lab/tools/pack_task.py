@@ -4,7 +4,9 @@ directory's bench.json, suite.json, tasks.json and the task's pack logs, as DEST
 to DIR, so the archives of all tasks unpack into one benchmark directory), and DEST/task_I.sha256: the archive's
 checksum, then each packed file's. Refuses, naming the runs, while any run of the task has no summary.json.
 TASK `new` packs every finished task that this DIR has not packed before (DIR/packed/task_I marks it), for a
-runner of all tasks (`kage.bench run --gpus`) whose tasks finish while it runs.
+runner of all tasks (`kage.bench run --gpus`) whose tasks finish while it runs: finished there means that the
+runner has also marked each run done (bench_state.json), since until its trainer exits it rewrites that file
+every 30 s, and a file rewritten between the archive and its checksum would not match on unpacking.
 
 usage: python3 lab/tools/pack_task.py DIR TASK|new DEST"""
 import hashlib
@@ -35,6 +37,17 @@ def task_runs(table: list, task: int) -> list:
 
 def unfinished_runs(root: str, runs: list) -> list:
     return [r for r in runs if not os.path.exists(os.path.join(root, r, "summary.json"))]
+
+
+def marked_done(root: str, runs: list) -> bool:
+    for run in runs:
+        try:
+            with open(os.path.join(root, run, "bench_state.json")) as f:
+                if json.load(f)["state"] != "done":
+                    return False
+        except (OSError, ValueError, KeyError):  # absent, or being rewritten
+            return False
+    return True
 
 
 def task_files(root: str, task: int) -> list:
@@ -79,7 +92,8 @@ def pack_new(root: str, dest: str) -> None:
     os.makedirs(marks, exist_ok=True)
     for task in range(len(table)):
         mark = os.path.join(marks, f"task_{task}")
-        if not os.path.exists(mark) and not unfinished_runs(root, task_runs(table, task)):
+        runs = task_runs(table, task)
+        if not os.path.exists(mark) and not unfinished_runs(root, runs) and marked_done(root, runs):
             pack(root, task, dest)
             open(mark, "w").close()
 
