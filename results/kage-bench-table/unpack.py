@@ -1,0 +1,65 @@
+"""Unpacks the packed tasks of the whole KAGE-Bench table (results/kage-bench-table/packs, written by
+lab/tools/pack_task.py) into one benchmark directory for `kage.bench report` and `kage.bench compare`. Each
+archive's checksum is checked before it is opened, and each unpacked file's after; a mismatch stops with the
+file's name.
+
+usage: python3 results/kage-bench-table/unpack.py PACKS DIR"""
+import hashlib
+import os
+import sys
+import tarfile
+
+
+def sha256(path: str) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def read_sums(path: str) -> list:
+    """[(digest, name)], the archive's first."""
+    sums = []
+    with open(path) as f:
+        for number, line in enumerate(f, 1):
+            digest, sep, name = line.rstrip("\n").partition("  ")
+            if not sep or len(digest) != 64:
+                sys.exit(f"unpack: {path}:{number}: not a sha256sum line (DIGEST  NAME)")
+            sums.append((digest, name))
+    return sums
+
+
+def unpack(packs: str, archive_name: str, dest: str) -> int:
+    archive = os.path.join(packs, archive_name)
+    sums_path = archive[:-len(".tar.gz")] + ".sha256"
+    if not os.path.exists(sums_path):
+        sys.exit(f"unpack: {archive} has no checksum list {sums_path}: bring it with the archive")
+    (archive_sum, listed), *files = read_sums(sums_path)
+    if listed != archive_name or sha256(archive) != archive_sum:
+        sys.exit(f"unpack: {archive}: its sha256 is not the one in {sums_path}:1; the archive is damaged")
+    with tarfile.open(archive) as tar:
+        tar.extractall(dest, filter="data")
+    for number, (digest, name) in enumerate(files, 2):
+        if sha256(os.path.join(dest, name)) != digest:
+            sys.exit(f"unpack: {os.path.join(dest, name)}: not the file of {sums_path}:{number}; another "
+                     "task's archive wrote it differently: unpack into an empty DIR")
+    return len(files)
+
+
+def main() -> None:
+    if len(sys.argv) != 3:
+        sys.exit(__doc__.splitlines()[-1])
+    packs, dest = sys.argv[1:]
+    names = sorted((n for n in os.listdir(packs) if n.endswith(".tar.gz")),
+                   key=lambda n: int(n[len("task_"):-len(".tar.gz")]))
+    if not names:
+        sys.exit(f"unpack: {packs}: no task_I.tar.gz archives")
+    os.makedirs(dest, exist_ok=True)
+    for name in names:
+        print(f"unpack: {name}: {unpack(packs, name, dest)} files checked")
+    print(f"unpack: {len(names)} tasks in {dest}; then: python3 -m kage.bench report {dest}")
+
+
+if __name__ == "__main__":
+    main()
