@@ -5,6 +5,10 @@ OUT=${OUT:-/tmp/kage-device-out}
 BUILD=${BUILD:-build-dev}
 mkdir -p "$OUT"
 DEPS=$PWD/.deps/usr
+if [ ! -d "$DEPS" ]; then
+  echo "device_build.sh: no $DEPS: make it here with lab/tools/make_deps.sh and carry .deps (or link it)" >&2
+  exit 1
+fi
 export CPATH=$DEPS/include
 export LD_LIBRARY_PATH=$DEPS/lib/x86_64-linux-gnu:/usr/local/cuda/lib64:${LD_LIBRARY_PATH:-}
 export KAGE_CACHE_DIR=/tmp/kage-cache PYTHONUNBUFFERED=1

@@ -6,9 +6,11 @@ checksum, then each packed file's. Refuses, naming the runs, while any run of th
 TASK `new` packs every finished task that this DIR has not packed before (DIR/packed/task_I marks it), for a
 runner of all tasks (`kage.bench run --gpus`) whose tasks finish while it runs: finished there means that the
 runner has also marked each run done (bench_state.json), since until its trainer exits it rewrites that file
-every 30 s, and a file rewritten between the archive and its checksum would not match on unpacking.
+every 30 s, and a file rewritten between the archive and its checksum would not match on unpacking. With
+MAX_FILES (the device machine's limit on the files a call brings back), `new` packs only as many tasks as
+leave DEST within it, and names the finished tasks it left for the next call.
 
-usage: python3 lab/tools/pack_task.py DIR TASK|new DEST"""
+usage: python3 lab/tools/pack_task.py DIR TASK|new DEST [MAX_FILES]"""
 import hashlib
 import json
 import os
@@ -84,26 +86,34 @@ def pack(root: str, task: int, dest: str) -> None:
     print(f"pack_task: task {task}: {len(files)} files, {os.path.getsize(archive) / 1e6:.1f} MB in {archive}")
 
 
-def pack_new(root: str, dest: str) -> None:
+def pack_new(root: str, dest: str, max_files: int) -> None:
     if not os.path.exists(os.path.join(root, "tasks.json")):
         return  # the runner has not written its task table yet
     table = task_table(root)
     marks = os.path.join(root, "packed")
     os.makedirs(marks, exist_ok=True)
+    left = []
     for task in range(len(table)):
         mark = os.path.join(marks, f"task_{task}")
         runs = task_runs(table, task)
-        if not os.path.exists(mark) and not unfinished_runs(root, runs) and marked_done(root, runs):
-            pack(root, task, dest)
-            open(mark, "w").close()
+        if os.path.exists(mark) or unfinished_runs(root, runs) or not marked_done(root, runs):
+            continue
+        if os.path.isdir(dest) and len(os.listdir(dest)) + 2 > max_files:
+            left.append(str(task))
+            continue
+        pack(root, task, dest)
+        open(mark, "w").close()
+    if left:
+        print(f"pack_task: task(s) {', '.join(left)} finished but not packed: {dest} would pass the {max_files} files a "
+              "call brings back; call again in this lease to bring them")
 
 
 def main() -> None:
-    if len(sys.argv) != 4:
+    if len(sys.argv) not in (4, 5):
         sys.exit(__doc__.splitlines()[-1])
-    root, task, dest = sys.argv[1:]
+    root, task, dest = sys.argv[1:4]
     if task == "new":
-        pack_new(root, dest)
+        pack_new(root, dest, int(sys.argv[4]) if len(sys.argv) == 5 else sys.maxsize)
     else:
         pack(root, int(task), dest)
 

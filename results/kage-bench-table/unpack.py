@@ -42,8 +42,8 @@ def unpack(packs: str, archive_name: str, dest: str) -> int:
         tar.extractall(dest, filter="data")
     for number, (digest, name) in enumerate(files, 2):
         if sha256(os.path.join(dest, name)) != digest:
-            sys.exit(f"unpack: {os.path.join(dest, name)}: not the file of {sums_path}:{number}; another "
-                     "task's archive wrote it differently: unpack into an empty DIR")
+            sys.exit(f"unpack: {os.path.join(dest, name)}: not the file of {sums_path}:{number}; the archive "
+                     "and its checksum list disagree: bring both again")
     return len(files)
 
 
