@@ -104,8 +104,8 @@ def pack_new(root: str, dest: str, max_files: int) -> None:
         pack(root, task, dest)
         open(mark, "w").close()
     if left:
-        print(f"pack_task: task(s) {', '.join(left)} finished but not packed: {dest} would pass the {max_files} files a "
-              "call brings back; call again in this lease to bring them")
+        print(f"pack_task: task(s) {', '.join(left)} finished but not packed: {dest} would pass the {max_files} "
+              "files a call brings back; call again in this lease to bring them")
 
 
 def main() -> None:

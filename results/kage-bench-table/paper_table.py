@@ -74,8 +74,9 @@ def pair_table(report: dict, paper: dict) -> list:
             continue
         s, d = p["metrics"][SUCCESS], p["metrics"][DISTANCE]
         drop = "n/a" if s["drop_pct"] is None else f"{s['drop_pct']:.1f} %"
+        paper_drop = paper["success_drop_pct"][p["axis"]]
         lines.append(f"| {p['pair']} | {p['n_seeds']} | {mean_sem(s['train'])} | {mean_sem(s['eval'])} | {drop} | "
-                     f"{d['train']['mean']:.0f} → {d['eval']['mean']:.0f} | {paper['success_drop_pct'][p['axis']]} % |")
+                     f"{d['train']['mean']:.0f} → {d['eval']['mean']:.0f} | {paper_drop} % |")
     return lines
 
 
