@@ -65,7 +65,7 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
     failed: List[int] = []
     stopping = threading.Event()
     started = time.monotonic()
-    done = [0]
+    finished = [0]  # tasks trained to the end: a stopped task's time says nothing of the rest's
 
     def worker(device: str) -> None:
         while True:
@@ -80,15 +80,15 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
             code = children[device].wait()
             log.close()
             with lock:
-                done[0] += 1
+                finished[0] += code == 0
                 if code != 0 and not stopping.is_set():
                     failed.append(index)
                 left = len(todo) + sum(c.poll() is None for c in children.values())
-                eta = (time.monotonic() - started) / done[0] * left
+                eta = (f" · ETA {(time.monotonic() - started) / finished[0] * left / 60:,.0f} min"
+                       if finished[0] and not stopping.is_set() else "")
                 status = ("done" if code == 0 else "stopped" if stopping.is_set()
                           else f"FAILED (exit {code}); see {log.name}")
-                print(f"[gpu {device}] task {index}: {status} · tasks left {left} · ETA {eta / 60:,.0f} min",
-                      file=sys.stderr, flush=True)
+                print(f"[gpu {device}] task {index}: {status} · tasks left {left}{eta}", file=sys.stderr, flush=True)
 
     threads = [threading.Thread(target=worker, args=(d,), daemon=True) for d in devices]
     for thread in threads:
