@@ -1,5 +1,6 @@
 """Packs one finished task of a benchmark directory for the trip home from a device machine: the task's run
-folders (metrics, summaries, configs, certificates, TensorBoard events, logs; never checkpoints) with the
+folders (metrics, summaries, configs, certificates, logs; neither checkpoints nor the TensorBoard events, which
+hold the same values as metrics.jsonl at twice its size: the whole table must travel to a device) with the
 directory's bench.json, suite.json, tasks.json and the task's pack logs, as DEST/task_I.tar.gz (paths relative
 to DIR, so the archives of all tasks unpack into one benchmark directory), and DEST/task_I.sha256: the archive's
 checksum, then each packed file's. Refuses, naming the runs, while any run of the task has no summary.json.
@@ -18,6 +19,7 @@ import sys
 import tarfile
 
 TOP = ("bench.json", "suite.json", "tasks.json")
+LEFT_OUT = ("checkpoints", "tensorboard")
 
 
 def sha256(path: str) -> str:
@@ -67,7 +69,7 @@ def task_files(root: str, task: int) -> list:
         files += [os.path.join("packs", n) for n in sorted(os.listdir(packs)) if n.startswith(f"task_{task}_")]
     for run in runs:
         for folder, dirs, names in os.walk(os.path.join(root, run)):
-            dirs[:] = sorted(d for d in dirs if d != "checkpoints")
+            dirs[:] = sorted(d for d in dirs if d not in LEFT_OUT)
             files += [os.path.relpath(os.path.join(folder, n), root) for n in sorted(names)]
     return files
 
