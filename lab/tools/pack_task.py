@@ -2,8 +2,9 @@
 folders (metrics, summaries, configs, certificates, logs; neither checkpoints nor the TensorBoard events, which
 hold the same values as metrics.jsonl at twice its size: the whole table must travel to a device) with the
 directory's bench.json, suite.json, tasks.json and the task's pack logs, as DEST/task_I.tar.gz (paths relative
-to DIR, so the archives of all tasks unpack into one benchmark directory), and DEST/task_I.sha256: the archive's
-checksum, then each packed file's. Refuses, naming the runs, while any run of the task has no summary.json.
+to DIR, so the archives of all tasks unpack into one benchmark directory), and DEST/task_I.sha256: `#` lines of
+provenance ($KAGE_PACK_PROVENANCE and the date), the archive's checksum, then each packed file's. Refuses,
+naming the runs, while any run of the task has no summary.json.
 TASK `new` packs every finished task that this DIR has not packed before (DIR/packed/task_I marks it), for a
 runner of all tasks (`kage.bench run --gpus`) whose tasks finish while it runs: finished there means that the
 runner has also marked each run done (bench_state.json), since until its trainer exits it rewrites that file
@@ -17,17 +18,24 @@ import json
 import os
 import sys
 import tarfile
+import time
 
+PROVENANCE = "KAGE_PACK_PROVENANCE"
 TOP = ("bench.json", "suite.json", "tasks.json")
 LEFT_OUT = ("checkpoints", "tensorboard")
 
 
 def sha256(path: str) -> str:
-    digest = hashlib.sha256()
     with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
+        return hashlib.file_digest(f, "sha256").hexdigest()
+
+
+def provenance() -> str:
+    """The checksum list's `#` lines: $KAGE_PACK_PROVENANCE's (device, commit, command; table_device.sh sets
+    it) and the time of packing."""
+    lines = [line for line in os.environ.get(PROVENANCE, "").splitlines() if line.strip()]
+    lines.append(f"date: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} (packed)")
+    return "".join(f"# {line}\n" for line in lines)
 
 
 def task_table(root: str) -> list:
@@ -82,6 +90,7 @@ def pack(root: str, task: int, dest: str) -> None:
         for name in files:
             tar.add(os.path.join(root, name), arcname=name)
     with open(os.path.join(dest, f"task_{task}.sha256"), "w") as f:
+        f.write(provenance())
         f.write(f"{sha256(archive + '.part')}  task_{task}.tar.gz\n")
         f.writelines(f"{sha256(os.path.join(root, n))}  {n}\n" for n in files)
     os.replace(archive + ".part", archive)  # last: a killed call leaves no archive that looks whole

@@ -1,5 +1,6 @@
-"""The published table (results/kage-bench-table) unpacks with its checksums, and `kage.bench report` and
-`kage.bench compare` run on it, as a user comparing an agent with the baseline runs them."""
+"""The published table (results/kage-bench-table) unpacks with its checksums (lab/tools/table_unpack.py), and
+`kage.bench report` and `kage.bench compare` run on it, as a user comparing an agent with the baseline runs
+them."""
 import csv
 import json
 import shutil
@@ -10,6 +11,7 @@ from support import ROOT
 from test_bench_e2e import bench
 
 TABLE = ROOT / "results/kage-bench-table"
+UNPACK = ROOT / "lab/tools/table_unpack.py"
 
 
 def packed_runs() -> int:
@@ -20,7 +22,7 @@ def packed_runs() -> int:
 
 def test_report_and_compare_run_on_the_published_table(tmp_path):
     baseline = tmp_path / "baseline"
-    unpack = subprocess.run([sys.executable, str(TABLE / "unpack.py"), str(TABLE / "packs"), str(baseline)],
+    unpack = subprocess.run([sys.executable, str(UNPACK), str(TABLE / "packs"), str(baseline)],
                             capture_output=True, text=True)
     assert unpack.returncode == 0, unpack.stderr
     runs = packed_runs()
@@ -50,7 +52,7 @@ def test_a_damaged_archive_is_refused_by_name(tmp_path):
     with open(archive, "r+b") as f:
         f.seek(100)
         f.write(b"\0" * 8)
-    unpack = subprocess.run([sys.executable, str(TABLE / "unpack.py"), str(packs), str(tmp_path / "out")],
+    unpack = subprocess.run([sys.executable, str(UNPACK), str(packs), str(tmp_path / "out")],
                             capture_output=True, text=True)
     assert unpack.returncode != 0
     assert f"{archive}: its sha256 is not the one in" in unpack.stderr

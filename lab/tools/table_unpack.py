@@ -1,32 +1,27 @@
 """Unpacks the packed tasks of the whole KAGE-Bench table (results/kage-bench-table/packs, written by
 lab/tools/pack_task.py) into one benchmark directory for `kage.bench report` and `kage.bench compare`. Each
 archive's checksum is checked before it is opened, and each unpacked file's after; a mismatch stops with the
-file's name.
+file's name. A checksum list's `#` lines (its provenance) are skipped, as `sha256sum -c` skips them.
 
-usage: python3 results/kage-bench-table/unpack.py PACKS DIR"""
-import hashlib
+usage: python3 lab/tools/table_unpack.py PACKS DIR"""
 import os
 import sys
 import tarfile
 
-
-def sha256(path: str) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
+from pack_task import sha256  # the checksums' one definition, beside this file
 
 
 def read_sums(path: str) -> list:
-    """[(digest, name)], the archive's first."""
+    """[(line number, digest, name)], the archive's first."""
     sums = []
     with open(path) as f:
         for number, line in enumerate(f, 1):
+            if line.startswith("#"):
+                continue
             digest, sep, name = line.rstrip("\n").partition("  ")
             if not sep or len(digest) != 64:
-                sys.exit(f"unpack: {path}:{number}: not a sha256sum line (DIGEST  NAME)")
-            sums.append((digest, name))
+                sys.exit(f"table_unpack: {path}:{number}: not a sha256sum line (DIGEST  NAME)")
+            sums.append((number, digest, name))
     return sums
 
 
@@ -34,15 +29,16 @@ def unpack(packs: str, archive_name: str, dest: str) -> int:
     archive = os.path.join(packs, archive_name)
     sums_path = archive[:-len(".tar.gz")] + ".sha256"
     if not os.path.exists(sums_path):
-        sys.exit(f"unpack: {archive} has no checksum list {sums_path}: bring it with the archive")
-    (archive_sum, listed), *files = read_sums(sums_path)
+        sys.exit(f"table_unpack: {archive} has no checksum list {sums_path}: bring it with the archive")
+    (number, archive_sum, listed), *files = read_sums(sums_path)
     if listed != archive_name or sha256(archive) != archive_sum:
-        sys.exit(f"unpack: {archive}: its sha256 is not the one in {sums_path}:1; the archive is damaged")
+        sys.exit(f"table_unpack: {archive}: its sha256 is not the one in {sums_path}:{number}; the archive is "
+                 "damaged")
     with tarfile.open(archive) as tar:
         tar.extractall(dest, filter="data")
-    for number, (digest, name) in enumerate(files, 2):
+    for number, digest, name in files:
         if sha256(os.path.join(dest, name)) != digest:
-            sys.exit(f"unpack: {os.path.join(dest, name)}: not the file of {sums_path}:{number}; the archive "
+            sys.exit(f"table_unpack: {os.path.join(dest, name)}: not the file of {sums_path}:{number}; the archive "
                      "and its checksum list disagree: bring both again")
     return len(files)
 
@@ -54,11 +50,11 @@ def main() -> None:
     names = sorted((n for n in os.listdir(packs) if n.endswith(".tar.gz")),
                    key=lambda n: int(n[len("task_"):-len(".tar.gz")]))
     if not names:
-        sys.exit(f"unpack: {packs}: no task_I.tar.gz archives")
+        sys.exit(f"table_unpack: {packs}: no task_I.tar.gz archives")
     os.makedirs(dest, exist_ok=True)
     for name in names:
-        print(f"unpack: {name}: {unpack(packs, name, dest)} files checked")
-    print(f"unpack: {len(names)} tasks in {dest}; then: python3 -m kage.bench report {dest}")
+        print(f"table_unpack: {name}: {unpack(packs, name, dest)} files checked")
+    print(f"table_unpack: {len(names)} tasks in {dest}; then: python3 -m kage.bench report {dest}")
 
 
 if __name__ == "__main__":
