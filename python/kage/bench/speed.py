@@ -10,8 +10,8 @@ pair (seeds 1..K) for a few iterations after a warm-up, then evaluates once, and
 - the time of one evaluation point (128 episodes on each of the two configs, per run);
 - the projected wall time of a pack through a full run (1,525 iterations and 32 evaluation points), per
   run, and for the 340-run table, and the aggregate steps/s of that full run (evaluations counted).
-This is a benchmark command, not a test: its numbers depend on the machine (record them under
-bench/results/ with the GPU and the date).
+This is a benchmark command, not a test: its numbers depend on the machine (record them in lab/
+with the GPU, the date and the command).
 """
 import argparse
 import dataclasses
