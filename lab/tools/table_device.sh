@@ -35,8 +35,8 @@ if [ ! -e "$DIR/tasks.json" ] && compgen -G "$PUBLISHED/task_*.tar.gz" >/dev/nul
   for archive in "$PUBLISHED"/task_*.tar.gz; do name=${archive##*/}; touch "$DIR/packed/${name%.tar.gz}"; done
 fi
 run=(python3 -m kage.bench run kage_bench --seeds 1-10 --share-training --pack "$PACK" "${scope[@]}" --out "$DIR")
-devices=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | sort | uniq -c | sed 's/^ *//' |
-  paste -sd ';' -)
+devices=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | sort | uniq -c |
+  sed -E 's/^ *([0-9]+) (.*), ([^,]*)$/\1 x \2 (driver \3)/' | paste -sd ';' -)  # 2 x NVIDIA H200 (driver 580.159.04)
 KAGE_PACK_PROVENANCE=$(printf 'device: %s\ncommit: %s\ncommand: bash lab/tools/table_device.sh (runs: %s %s)' \
   "$devices" "$COMMIT" "${run[*]}" "$FLAGS")
 export KAGE_PACK_PROVENANCE
