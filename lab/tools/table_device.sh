@@ -1,30 +1,40 @@
 #!/usr/bin/env bash
-# One device-machine call of the whole KAGE-Bench table (issue 27). Builds (lab/tools/device_build.sh), then
-# trains `kage.bench run kage_bench --seeds 1-10 --share-training --pack PACK` with the trainer flags FLAGS, in
-# DIR on the machine's disk, for at most LIMIT seconds of the call:
+# One device-machine call of the whole KAGE-Bench table (issue 27). The runner, `kage.bench run kage_bench
+# --seeds 1-10 --share-training --pack PACK` with the trainer flags FLAGS, trains in DIR on the machine's disk:
 # - GPUS=all (a machine of several GPUs): every task, one worker per GPU (`--gpus all`);
 # - TASK=I: task I alone, on one GPU.
-# A lease's first call starts DIR from the tasks already published (results/kage-bench-table/packs, unpacked
-# with their checksums), so that only the rest is trained. A call stopped by LIMIT leaves the runs' checkpoints
-# in DIR, and the next call of the same lease resumes them (the disk goes with the lease, so size PACK for one
-# lease). Each task is packed as soon as all its runs have finished: its run data without checkpoints, in
-# $OUT/task_I.tar.gz and $OUT/task_I.sha256 (lab/tools/pack_task.py), so a call cut short still brings its
-# finished tasks home; copy them into results/kage-bench-table/packs at once. $OUT holds at most MAX_FILES
-# (the device's limit on the files a call brings back): the call's log, $OUT/call.log, and as many tasks as
-# fit; a task left over is named, for the next call. A task index names the same runs in every lease
-# (kage.bench.tasks), and DIR must be the same path in every lease, since bench.json records it. COMMIT names
-# the tree's commit (the machine gets no .git) for the packs' provenance, beside the device and the command.
-# Run with carry [".deps"]:
+# The runner runs in a process session of its own (setsid), which the device machine leaves running when a
+# call returns, so it trains on through the lease's calls and the gaps between them, never stopped and resumed.
+# It runs from a copy of the tree made by the lease's first call (ROOT), since every call copies the working
+# tree afresh over the repository root, which must not change under a running process: a lease runs the code
+# of its first call. That call builds (lab/tools/device_build.sh) and starts DIR from the tasks already
+# published (results/kage-bench-table/packs, unpacked with their checksums), so that only the rest is trained.
+# Every call then waits until LIMIT seconds of the call have passed or the runner has ended, packing each task
+# as soon as all its runs have finished: its run data without checkpoints, in $OUT/task_I.tar.gz and
+# $OUT/task_I.sha256 (lab/tools/pack_task.py), so a call brings home what finished since the last; copy them
+# into results/kage-bench-table/packs at once. A call that finds no runner with tasks left (it failed, or the
+# first call's ended) starts one again, which resumes the runs from their checkpoints. $OUT holds at most
+# MAX_FILES (the device's limit on the files a call brings back): the call's log, $OUT/call.log (the build's
+# lines, then the runner's since the last call), and as many tasks as fit; a task left over is named, for the
+# next call. What the runner has not finished when the lease ends goes with the machine. A task index names the
+# same runs in every lease (kage.bench.tasks), and DIR must be the same path in every lease, since bench.json
+# records it. COMMIT names the tree's commit (the machine gets no .git) for the packs' provenance, beside the
+# device and the command. Run with carry [".deps"]:
 #   COMMIT=$(git rev-parse --short HEAD) GPUS=all PACK=6 bash lab/tools/table_device.sh
 #   COMMIT=... TASK=0 PACK=6 bash lab/tools/table_device.sh
 set -uo pipefail
 if [ -n "${GPUS:-}" ]; then scope=(--gpus "$GPUS"); else scope=(--task "${TASK:?GPUS=all or TASK=I}"); fi
 : "${COMMIT:?COMMIT=<the commit of this tree>: recorded in the checksum list of each pack}"
-source lab/tools/device_build.sh
+ROOT=${ROOT:-/tmp/kage-table-tree}
+if [ ! -e "$ROOT/.copied" ]; then
+  rm -rf "$ROOT" && mkdir -p "$ROOT" && cp -a . "$ROOT" && touch "$ROOT/.copied" || exit 1
+fi
+cd "$ROOT" || exit 1
+source lab/tools/device_build.sh  # incremental: builds once a lease, since ROOT does not change
 cat "$OUT/gpu.txt" >"$OUT/call.log" && rm -f "$OUT/gpu.txt" "$OUT/build.log"  # one log file: the build passed
 PACK=${PACK:-6}
 DIR=${DIR:-/tmp/kage-table}
-LIMIT=${LIMIT:-570}
+LIMIT=${LIMIT:-585}
 MAX_FILES=${MAX_FILES:-8}
 FLAGS=${FLAGS:---bf16 --fused-input --cuda-graph --triton-conv}
 PUBLISHED=results/kage-bench-table/packs
@@ -41,14 +51,21 @@ KAGE_PACK_PROVENANCE=$(printf 'device: %s\ncommit: %s\ncommand: bash lab/tools/t
   "$devices" "$COMMIT" "${run[*]}" "$FLAGS")
 export KAGE_PACK_PROVENANCE
 pack_new() { python3 lab/tools/pack_task.py "$DIR" new "$OUT" "$MAX_FILES" >>"$OUT/call.log"; }
-left=$((LIMIT - SECONDS - 75))  # 75 s to stop (SIGTERM ends the iteration or evaluation point, then checkpoints)
-if [ "$left" -gt 60 ]; then
-  # shellcheck disable=SC2086
-  timeout --signal=TERM --kill-after=45 "$left" "${run[@]}" $FLAGS >>"$OUT/call.log" 2>&1 &
-  runner=$!
-  while kill -0 "$runner" 2>/dev/null; do sleep 10; pack_new; done
-  wait "$runner"
+runner_alive() { [ -s "$DIR/runner.pid" ] && kill -0 "$(cat "$DIR/runner.pid")" 2>/dev/null; }
+mkdir -p "$DIR"
+runner_log=$DIR/runner.log
+seen=$(stat -c %s "$runner_log" 2>/dev/null || echo 0)  # what earlier calls brought home
+if ! runner_alive; then  # with every task finished, the runner says so and ends at once
+  echo "table_device: starting the runner ($(date -u +%H:%M:%S) UTC)" >>"$runner_log"
+  rm -f "$DIR/runner.pid"
+  # The runner writes its own pid: setsid forks when it cannot make its caller a session leader.
+  # shellcheck disable=SC2016,SC2086
+  setsid bash -c 'echo $$ >"$0/runner.pid" && exec "$@"' "$DIR" "${run[@]}" $FLAGS >>"$runner_log" 2>&1 </dev/null &
+  for _ in 1 2 3 4 5; do [ -s "$DIR/runner.pid" ] && break; sleep 1; done
 fi
+while runner_alive && [ "$SECONDS" -lt $((LIMIT - 25)) ]; do sleep 10; pack_new; done  # 25 s: pack, log, status
 pack_new
+tail -c +$((seen + 1)) "$runner_log" | grep -v '^iteration' >>"$OUT/call.log"
+runner_alive && echo "table_device: the runner trains on ($(date -u +%H:%M:%S) UTC); call again" >>"$OUT/call.log"
 python3 -m kage.bench status "$DIR" >>"$OUT/call.log" 2>&1
-grep -v '^iteration' "$OUT/call.log" | tail -40
+tail -40 "$OUT/call.log"
