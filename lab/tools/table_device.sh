@@ -65,7 +65,11 @@ if ! runner_alive; then  # with every task finished, the runner says so and ends
 fi
 while runner_alive && [ "$SECONDS" -lt $((LIMIT - 25)) ]; do sleep 10; pack_new; done  # 25 s: pack, log, status
 pack_new
-tail -c +$((seen + 1)) "$runner_log" | grep -v '^iteration' >>"$OUT/call.log"
+new_lines=$(tail -c +$((seen + 1)) "$runner_log" | grep -v '^iteration')
+printf '%s\n' "$new_lines" >>"$OUT/call.log"
+for log in $(printf '%s\n' "$new_lines" | grep -o 'FAILED (exit [0-9-]*); see [^ ]*' | sed 's/.*; see //' | sort -u); do
+  { echo "table_device: the end of $log"; tail -25 "$log"; } >>"$OUT/call.log"  # the cause, without another call
+done
 runner_alive && echo "table_device: the runner trains on ($(date -u +%H:%M:%S) UTC); call again" >>"$OUT/call.log"
 python3 -m kage.bench status "$DIR" >>"$OUT/call.log" 2>&1
 tail -40 "$OUT/call.log"
