@@ -1,7 +1,7 @@
 """kage.bench compare: two benchmark directories side by side (IQMs with intervals, P(X > Y), the overlaid
 plots), on hand-made directories with values worked out here and end to end on two tiny CPU benchmarks (the
-baseline and the random-shift agent); and its refusals of directories whose suite, seeds, pairs or protocol
-differ."""
+baseline and the random-shift agent); that it compares only the (pair, seed) results every directory has; and
+its refusals of directories whose suite, seeds or protocol differ."""
 import csv
 import json
 import shutil
@@ -105,11 +105,46 @@ def test_refuses_other_seeds(two, tmp_path):
         compare.compare([str(a), str(fewer)], reps=100)
 
 
-def test_refuses_other_pairs(two):
+def test_compares_the_results_every_method_has(two):
+    """B ran two of the three pairs (run --pairs) and its seed 3 is still training: both are compared on seeds 1
+    and 2 of background/1 and 2, and compare.md names what A has beyond them."""
     a, b = two
     bench = json.loads((b / "bench.json").read_text())
     (b / "bench.json").write_text(json.dumps({**bench, "units": ["background/1", "background/2"]}))
-    with pytest.raises(SystemExit, match=r"ran other pairs \(layout/1 in one only\)"):
+    shutil.rmtree(b / "runs" / "layout/1")
+    for name in ("background/1", "background/2"):
+        (b / "runs" / name / "seed_3" / "summary.json").unlink()
+    result = compare.compare([str(a), str(b)], reps=500)
+    assert result["results_compared"] == 4
+    methods = {m["name"]: m for m in result["methods"]}
+    assert methods["A"]["results_finished"] == 9 and methods["B"]["results_finished"] == 4
+    assert methods["A"]["left_out"] == [{"pair": "background/1", "seed": 3}, {"pair": "background/2", "seed": 3},
+                                        *({"pair": "layout/1", "seed": s} for s in (1, 2, 3))]
+    assert methods["B"]["left_out"] == []
+    estimates = {m["name"]: {r["name"]: r for r in m["estimates"]["rows"]} for m in result["methods"]}
+    # A's background eval, seeds 1 and 2: 0.2 0.3 0.5 0.6, one cut at each end: IQM 0.4; B's 0.1 0.1 0.4 0.6 -> 0.25
+    assert estimates["A"]["background"]["eval_iqm"]["point"] == pytest.approx(0.4)
+    assert estimates["B"]["background"]["eval_iqm"]["point"] == pytest.approx(0.25)
+    p = {(r["name"], r["x"], r["y"]): r for r in result["improvement"]}
+    # background/1: A's 0.5 beats 0.1 (1), 0.6 beats 0.1 and ties 0.6 (1.5): 2.5 / 4; background/2: A's 0.2 and 0.3
+    # each beat 0.1 only: 2 / 4
+    assert p[("background", "A", "B")]["p"]["point"] == pytest.approx((2.5 / 4 + 2 / 4) / 2)
+    assert {name for name, _, _ in p} == {r["name"] for r in estimates["A"].values()} == {"background", "all pairs"}
+    md = (a / "compare" / "compare.md").read_text()
+    assert ("Compared on the 4 (pair, seed) results that every method has finished; left out, finished by some "
+            "methods only: **A** 5: background/1 (seed 3), background/2 (seed 3), layout/1 (3 seeds).") in md
+
+
+def test_refuses_directories_with_no_result_in_common(two):
+    a, b = two
+    bench = json.loads((b / "bench.json").read_text())
+    (b / "bench.json").write_text(json.dumps({**bench, "units": ["layout/1"]}))
+    for name in ("background/1", "background/2"):
+        shutil.rmtree(b / "runs" / name)
+    for seed in (1, 2, 3):
+        (b / "runs" / "layout/1" / f"seed_{seed}" / "summary.json").unlink()
+    with pytest.raises(SystemExit, match=r"no \(pair, seed\) result is finished in every directory \(finished: A 9, B "
+                                         r"0\): run the same pairs and seeds"):
         compare.compare([str(a), str(b)], reps=100)
 
 

@@ -14,11 +14,14 @@ and over all plain pairs:
 Success is `success_once`; --metric chooses `success` or `progress` instead (after a few thousand steps no agent
 succeeds, while their progress already differs).
 
-Only finished runs enter, each scored as `kage.bench report --protocol` scores it. The directories must have the
-same suite (the same pairs with the same train and eval Specs), the same seeds and pairs run, and the same
-training and evaluation protocol (run.json: total steps, steps between evaluations, evaluation episodes and
-environments, sampled or greedy evaluation); a directory that differs is refused, naming what differs. The
-methods are named after their directories unless --names is given.
+Only finished runs enter, each scored as `kage.bench report --protocol` scores it, and only the (pair, seed)
+results that every directory has finished, so that each estimate and each P(X > Y) compares the same pairs and
+seeds: a directory whose runs are not all finished yet (a baseline still being published, a run still training)
+or that ran other pairs (`kage.bench run --pairs`) is compared on what all have, and compare.md names each
+method's results left out. The directories must have the same suite (the same pairs with the same train and
+eval Specs), the same seeds and the same training and evaluation protocol (run.json: total steps, steps between
+evaluations, evaluation episodes and environments, sampled or greedy evaluation); a directory that differs is
+refused, naming what differs. The methods are named after their directories unless --names is given.
 
 Output, in DIR_A/compare/ (or --out): compare.md, compare.csv (the estimates, one row per method and axis),
 improvement.csv (P(X > Y) per axis and pair of methods), compare.json (everything) and plots/intervals.png,
@@ -28,8 +31,8 @@ import argparse
 import json
 import os
 import sys
-from dataclasses import dataclass
-from typing import Dict, List, NoReturn, Optional
+from dataclasses import dataclass, field
+from typing import Dict, List, NoReturn, Optional, Set, Tuple
 
 from kage.bench import intervals, plots, report, stats
 from kage.bench.interval_tables import explanation, fmt_drop, fmt_interval, intervals_csv
@@ -49,10 +52,13 @@ class Method:
     bench_dir: str
     suite: dict
     seeds: List[int]
-    pairs_run: List[str]  # the suite's pairs whose units were run
     schedule: dict  # the SCHEDULE_ARGS its runs were trained with ({} where no run.json has arguments)
-    levels: dict
-    estimates: dict
+    units: List[report.Unit]
+    runs: Dict[str, List[report.Run]]
+    results: Set[Tuple[str, int]]  # the (pair, seed) results it has finished
+    levels: dict = field(default_factory=dict)  # of the results that every method has (restrict)
+    left_out: List[Tuple[str, int]] = field(default_factory=list)  # its results that another method lacks
+    estimates: dict = field(default_factory=dict)
 
 
 def schedule_of(run: report.Run) -> dict:
@@ -66,7 +72,7 @@ def schedule_of(run: report.Run) -> dict:
             "eval_greedy": args.get("eval_greedy")}
 
 
-def load(bench_dir: str, name: str, protocol: str, reps: int, metric: str) -> Method:
+def load(bench_dir: str, name: str, protocol: str) -> Method:
     suite, bench, units, runs = report.read_benchmark(bench_dir)
     every_run = [r for unit_runs in runs.values() for r in unit_runs]
     schedules = {json.dumps(schedule_of(r), sort_keys=True) for r in every_run if r.args}
@@ -77,9 +83,8 @@ def load(bench_dir: str, name: str, protocol: str, reps: int, metric: str) -> Me
     levels = report.aggregate(units, runs, protocol)
     if not levels["pairs"]:
         fail(f"{bench_dir} has no plain pair (only sweeps): compare reads plain pairs")
-    return Method(name, bench_dir, suite, sorted(seeds), sorted(p["pair"] for u in units for p in u.pairs),
-                  json.loads(schedules.pop()) if schedules else {}, levels,
-                  intervals.interval_report(levels["runs"], levels["pairs"], reps, metric))
+    return Method(name, bench_dir, suite, sorted(seeds), json.loads(schedules.pop()) if schedules else {}, units,
+                  runs, {(r["pair"], r["seed"]) for r in levels["runs"]})
 
 
 def suite_differences(a: Method, b: Method) -> List[str]:
@@ -108,14 +113,40 @@ def check_comparable(methods: List[Method]) -> None:
             fail(f"{pair} are not of the same suite: {'; '.join(differences[:3])}: compare runs of one suite")
         if first.seeds != other.seeds:
             fail(f"{pair} have other seeds ({first.seeds} and {other.seeds}): run both with the same --seeds")
-        if first.pairs_run != other.pairs_run:
-            only = sorted(set(first.pairs_run) ^ set(other.pairs_run))
-            fail(f"{pair} ran other pairs ({', '.join(only[:5])} in one only): run both with the same --pairs")
         keys = [k for k in SCHEDULE_ARGS if first.schedule.get(k) != other.schedule.get(k)]
         if keys:
             shown = ", ".join(f"{k} {first.schedule.get(k)} and {other.schedule.get(k)}" for k in keys)
             fail(f"{pair} were trained or evaluated with another protocol ({shown}): compare runs trained and "
                  "evaluated alike")
+
+
+def restrict(methods: List[Method], protocol: str, reps: int, metric: str) -> None:
+    """Scores every method on the (pair, seed) results that all of them have finished, and notes what each
+    leaves out; refuses when they have none in common."""
+    common = set.intersection(*(m.results for m in methods))
+    if not common:
+        counts = ", ".join(f"{m.name} {len(m.results)}" for m in methods)
+        fail(f"no (pair, seed) result is finished in every directory (finished: {counts}): run the same pairs "
+             "and seeds, or wait for the runs to finish (kage.bench status DIR)")
+    pairs = {pair for pair, _ in common}
+    for m in methods:
+        m.left_out = sorted(m.results - common)
+        m.levels = report.aggregate(m.units, m.runs, protocol, keep=common)
+        m.levels["pairs"] = [p for p in m.levels["pairs"] if p["pair"] in pairs]  # rows of the pairs compared
+        m.levels["axes"] = report.axes_of(m.levels["pairs"])
+        m.estimates = intervals.interval_report(m.levels["runs"], m.levels["pairs"], reps, metric)
+
+
+def left_out_text(m: Method, shown: int = 12) -> str:
+    """A method's results left out, grouped by pair: 'background/4 (10 seeds), background/6 (seeds 1, 2)', the
+    first `shown` pairs (compare.json lists every one)."""
+    seeds: Dict[str, List[int]] = {}
+    for pair, seed in m.left_out:
+        seeds.setdefault(pair, []).append(seed)
+    parts = [f"{pair} ({len(s)} seeds)" if len(s) == len(m.seeds) else
+             f"{pair} (seed{'s' if len(s) > 1 else ''} {', '.join(map(str, s))})" for pair, s in seeds.items()]
+    more = f", ... ({len(parts)} pairs; compare.json lists them)" if len(parts) > shown else ""
+    return f"**{m.name}** {len(m.left_out)}: {', '.join(parts[:shown])}{more}"
 
 
 def improvement(x: Method, y: Method, pairs: List[dict], reps: int) -> dict:
@@ -149,8 +180,8 @@ def improvements(methods: List[Method], reps: int) -> List[dict]:
 # ---- tables ----
 
 def md_estimates(methods: List[Method], key: str, fmt) -> str:
-    rows = [[row["name"]] + [fmt(m.estimates["rows"][i][key]) for m in methods]
-            for i, row in enumerate(methods[0].estimates["rows"])]
+    by_name = [{row["name"]: row for row in m.estimates["rows"]} for m in methods]  # axes in each one's pair order
+    rows = [[row["name"]] + [fmt(rows[row["name"]][key]) for rows in by_name] for row in methods[0].estimates["rows"]]
     return md_table(["axis"] + [m.name for m in methods], rows, 1)
 
 
@@ -165,11 +196,15 @@ def md_improvements(rows: List[dict]) -> str:
 
 def markdown(methods: List[Method], rows: List[dict], protocol: str) -> str:
     metric = methods[0].estimates["metric"]
-    listed = "; ".join(f"**{m.name}**: `{m.bench_dir}`, {len({(r['unit'], r['seed']) for r in m.levels['runs']})} "
-                       "finished runs" for m in methods)
+    listed = "; ".join(f"**{m.name}**: `{m.bench_dir}`, {len(m.results)} finished (pair, seed) results"
+                       for m in methods)
+    compared = len(methods[0].results) - len(methods[0].left_out)
+    left_out = [left_out_text(m) for m in methods if m.left_out]
     schedule = ", ".join(f"{k} {v}" for k, v in methods[0].schedule.items() if v is not None) or "not recorded"
     return (f"# {methods[0].suite.get('suite', 'suite')}: {' vs '.join(m.name for m in methods)}\n\n"
-            f"Methods: {listed}. Seeds {methods[0].seeds}; the same suite, seeds, pairs and protocol ({schedule}). "
+            f"Methods: {listed}. Seeds {methods[0].seeds}; the same suite, seeds and protocol ({schedule}). "
+            f"Compared on the {compared} (pair, seed) results that every method has finished"
+            f"{'; left out, finished by some methods only: ' + '; '.join(left_out) if left_out else ''}. "
             f"{report.LEVEL_1[protocol][0].upper()}{report.LEVEL_1[protocol][1:]}.\n\n"
             f"## IQM of eval `{metric}`\n\n{md_estimates(methods, 'eval_iqm', fmt_interval)}\n"
             f"## IQM of train `{metric}`\n\n{md_estimates(methods, 'train_iqm', fmt_interval)}\n"
@@ -212,14 +247,18 @@ def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optiona
         fail(f"unknown protocol '{protocol}': choose {' or '.join(report.PROTOCOLS)}")
     if metric not in intervals.METRICS:
         fail(f"--metric takes {', '.join(intervals.METRICS)}, not '{metric}'")
-    methods = [load(d, name, protocol, reps, metric) for d, name in zip(dirs, method_names(dirs, names))]
+    methods = [load(d, name, protocol) for d, name in zip(dirs, method_names(dirs, names))]
     check_comparable(methods)
+    restrict(methods, protocol, reps, metric)
     rows = improvements(methods, reps)
     out_dir = out_dir or os.path.join(dirs[0], "compare")
     result = {"kage_bench_compare": 1, "suite": methods[0].suite.get("suite", "suite"), "out_dir": out_dir,
               "protocol": {"score": protocol, "level_1_runs": report.LEVEL_1[protocol], **methods[0].schedule},
               "seeds": methods[0].seeds,
-              "methods": [{"name": m.name, "bench_dir": m.bench_dir, "estimates": m.estimates} for m in methods],
+              "results_compared": len(methods[0].results) - len(methods[0].left_out),
+              "methods": [{"name": m.name, "bench_dir": m.bench_dir, "results_finished": len(m.results),
+                           "left_out": [{"pair": p, "seed": s} for p, s in m.left_out], "estimates": m.estimates}
+                          for m in methods],
               "improvement": rows}
     try:
         write(out_dir, methods, result)

@@ -65,7 +65,7 @@ import re
 import statistics
 import sys
 from dataclasses import dataclass, field
-from typing import Dict, List, NoReturn, Optional, Sequence, Tuple
+from typing import Dict, List, NoReturn, Optional, Sequence, Set, Tuple
 
 from kage.bench import intervals, plots
 from kage.bench.records import bench_problem
@@ -314,18 +314,23 @@ def sweep_order(names: List[str]) -> List[str]:
         return list(names)
 
 
-def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "max", partial: bool = False) -> dict:
+def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "max", partial: bool = False,
+              keep: Optional[Set[Tuple[str, int]]] = None) -> dict:
     """The three levels: {"runs": level 1, "pairs": level 2 (plain pairs), "axes": level 3, "sweeps": level 2
-    per sweep}; `protocol` and `partial` choose the runs and their values (run_values)."""
+    per sweep}; `protocol` and `partial` choose the runs and their values (run_values), and `keep`, where
+    given, the (pair, seed) results that enter (kage.bench compare: those of every method)."""
     level1, pairs, sweeps = [], [], []
     for unit in units:
         scored = [(r, v) for r in runs[unit.name] for v in [run_values(r, protocol, partial)] if v is not None]
+        if keep is not None:
+            scored = [(r, v) for r, v in scored if any((p["pair"], r.seed) in keep for p in unit.pairs)]
         included = [r for r, _ in scored]
         results = {}
         for pair in unit.pairs:
             label = unit.label(pair)
             per_run = []
-            for run, run_value in scored:
+            kept = [(r, v) for r, v in scored if keep is None or (pair["pair"], r.seed) in keep]
+            for run, run_value in kept:
                 from_summary = protocol == "max" and run.stats is not None
                 where = os.path.join(run.path, "summary.json" if from_summary else "metrics.jsonl")
                 values = run_scores(run_value, label, where)
@@ -335,7 +340,7 @@ def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "ma
             results[pair["pair"]] = {
                 "pair": pair["pair"], "axis": pair["declared_axis"], "certified": pair.get("certified"),
                 "train_spec": pair["train"].get("spec_sha256", pair["train"].get("name")),
-                "n_seeds": len(included), "seeds": [r.seed for r in included], "metrics": over_seeds(per_run)}
+                "n_seeds": len(kept), "seeds": [r.seed for r, _ in kept], "metrics": over_seeds(per_run)}
         if not unit.is_sweep:
             pairs.extend(results[p["pair"]] for p in unit.pairs)
             continue
