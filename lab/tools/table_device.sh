@@ -47,8 +47,10 @@ fi
 run=(python3 -m kage.bench run kage_bench --seeds 1-10 --share-training --pack "$PACK" "${scope[@]}" --out "$DIR")
 devices=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | sort | uniq -c |
   sed -E 's/^ *([0-9]+) (.*), ([^,]*)$/\1 x \2 (driver \3)/' | paste -sd ';' -)  # 2 x NVIDIA H200 (driver 580.159.04)
-KAGE_PACK_PROVENANCE=$(printf 'device: %s\ncommit: %s\ncommand: bash lab/tools/table_device.sh (runs: %s %s)' \
-  "$devices" "$COMMIT" "${run[*]}" "$FLAGS")
+# The exact call, its settings included, and the runner it drives.
+call="COMMIT=$COMMIT ${GPUS:+GPUS=$GPUS }${TASK:+TASK=$TASK }PACK=$PACK LIMIT=$LIMIT bash lab/tools/table_device.sh"
+KAGE_PACK_PROVENANCE=$(printf 'device: %s\ncommit: %s\ncommand: %s (runner: %s %s)' \
+  "$devices" "$COMMIT" "$call" "${run[*]}" "$FLAGS")
 export KAGE_PACK_PROVENANCE
 pack_new() { python3 lab/tools/pack_task.py "$DIR" new "$OUT" "$MAX_FILES" >>"$OUT/call.log"; }
 runner_alive() { [ -s "$DIR/runner.pid" ] && kill -0 "$(cat "$DIR/runner.pid")" 2>/dev/null; }
