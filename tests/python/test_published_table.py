@@ -26,7 +26,7 @@ def test_report_and_compare_run_on_the_published_table(tmp_path):
                             capture_output=True, text=True)
     assert unpack.returncode == 0, unpack.stderr
     runs = packed_runs()
-    assert runs >= 38  # tasks 0 to 6, published on 2026-11-26; more as the table fills
+    assert runs >= 74  # tasks 0 to 12 and 14, published on 2026-11-26; more as the table fills
 
     report = bench("report", str(baseline))
     assert report.returncode == 0, report.stderr
