@@ -10,7 +10,8 @@ runner of all tasks (`kage.bench run --gpus`) whose tasks finish while it runs: 
 runner has also marked each run done (bench_state.json), since until its trainer exits it rewrites that file
 every 30 s, and a file rewritten between the archive and its checksum would not match on unpacking. With
 MAX_FILES (the device machine's limit on the files a call brings back), `new` packs only as many tasks as
-leave DEST within it, and names the finished tasks it left for the next call.
+leave DEST within it, names the finished tasks it left for the next call, and exits with status 3
+(LEFT_FOR_NEXT_CALL), so that the call can end at once and the next bring them home before the lease ends.
 
 usage: python3 lab/tools/pack_task.py DIR TASK|new DEST [MAX_FILES]"""
 import hashlib
@@ -23,6 +24,7 @@ import time
 PROVENANCE = "KAGE_PACK_PROVENANCE"
 TOP = ("bench.json", "suite.json", "tasks.json")
 LEFT_OUT = ("checkpoints", "tensorboard")
+LEFT_FOR_NEXT_CALL = 3
 
 
 def sha256(path: str) -> str:
@@ -97,9 +99,10 @@ def pack(root: str, task: int, dest: str) -> None:
     print(f"pack_task: task {task}: {len(files)} files, {os.path.getsize(archive) / 1e6:.1f} MB in {archive}")
 
 
-def pack_new(root: str, dest: str, max_files: int) -> None:
+def pack_new(root: str, dest: str, max_files: int) -> list:
+    """Packs the tasks newly finished; returns those finished but left for the next call."""
     if not os.path.exists(os.path.join(root, "tasks.json")):
-        return  # the runner has not written its task table yet
+        return []  # the runner has not written its task table yet
     table = task_table(root)
     marks = os.path.join(root, "packed")
     os.makedirs(marks, exist_ok=True)
@@ -117,6 +120,7 @@ def pack_new(root: str, dest: str, max_files: int) -> None:
     if left:
         print(f"pack_task: task(s) {', '.join(left)} finished but not packed: {dest} would pass the {max_files} "
               "files a call brings back; call again in this lease to bring them")
+    return left
 
 
 def main() -> None:
@@ -124,7 +128,8 @@ def main() -> None:
         sys.exit(__doc__.splitlines()[-1])
     root, task, dest = sys.argv[1:4]
     if task == "new":
-        pack_new(root, dest, int(sys.argv[4]) if len(sys.argv) == 5 else sys.maxsize)
+        if pack_new(root, dest, int(sys.argv[4]) if len(sys.argv) == 5 else sys.maxsize):
+            sys.exit(LEFT_FOR_NEXT_CALL)
     else:
         pack(root, int(task), dest)
 

@@ -15,11 +15,11 @@
 # into results/kage-bench-table/packs at once. A call that finds no runner with tasks left (it failed, or the
 # first call's ended) starts one again, which resumes the runs from their checkpoints. $OUT holds at most
 # MAX_FILES (the device's limit on the files a call brings back): the call's log, $OUT/call.log (the build's
-# lines, then the runner's since the last call), and as many tasks as fit; a task left over is named, for the
-# next call. What the runner has not finished when the lease ends goes with the machine. A task index names the
-# same runs in every lease (kage.bench.tasks), and DIR must be the same path in every lease, since bench.json
-# records it. COMMIT names the tree's commit (the machine gets no .git) for the packs' provenance, beside the
-# device and the command. Run with carry [".deps"]:
+# lines, then the runner's since the last call), and as many tasks as fit; a finished task left over ends the
+# call at once and is named, for the next call. What the runner has not finished when the lease ends goes with
+# the machine. A task index names the same runs in every lease (kage.bench.tasks), and DIR must be the same path
+# in every lease, since bench.json records it. COMMIT names the tree's commit (the machine gets no .git) for the
+# packs' provenance, beside the device and the command. Run with carry [".deps"]:
 #   COMMIT=$(git rev-parse --short HEAD) GPUS=all PACK=6 bash lab/tools/table_device.sh
 #   COMMIT=... TASK=0 PACK=6 bash lab/tools/table_device.sh
 set -uo pipefail
@@ -65,7 +65,9 @@ if ! runner_alive; then  # with every task finished, the runner says so and ends
   setsid bash -c 'echo $$ >"$0/runner.pid" && exec "$@"' "$DIR" "${run[@]}" $FLAGS >>"$runner_log" 2>&1 </dev/null &
   for _ in 1 2 3 4 5; do [ -s "$DIR/runner.pid" ] && break; sleep 1; done
 fi
-while runner_alive && [ "$SECONDS" -lt $((LIMIT - 25)) ]; do sleep 10; pack_new; done  # 25 s: pack, log, status
+# A finished task that $OUT has no room for (pack_task's status 3) ends the call at once, for the next to
+# bring home while the lease lasts; so does any other failure of packing, which the log then shows.
+while runner_alive && [ "$SECONDS" -lt $((LIMIT - 25)) ]; do sleep 10; pack_new || break; done  # 25 s: log, status
 pack_new
 new_lines=$(tail -c +$((seen + 1)) "$runner_log" | grep -v '^iteration')
 printf '%s\n' "$new_lines" >>"$OUT/call.log"

@@ -1,0 +1,98 @@
+"""lab/tools/pack_task.py packs the finished tasks of a benchmark directory for the trip home from a device
+machine, within the files a call brings back, and lab/tools/table_unpack.py unpacks them with their checksums."""
+import hashlib
+import json
+import subprocess
+import sys
+import tarfile
+
+from support import ROOT
+
+PACK_TASK = ROOT / "lab/tools/pack_task.py"
+UNPACK = ROOT / "lab/tools/table_unpack.py"
+TASKS = [[("a/1", 1), ("a/1", 2)], [("b/1", 1)], [("c/1", 1)]]
+
+
+def benchmark(root, state="done"):
+    """A benchmark directory as `kage.bench run --pack` leaves it, every run finished."""
+    root.mkdir()
+    (root / "tasks.json").write_text(json.dumps(
+        {"pack": 2, "tasks": [[{"unit": u, "seed": s} for u, s in task] for task in TASKS]}))
+    (root / "bench.json").write_text("{}")
+    (root / "suite.json").write_text("{}")
+    (root / "packs").mkdir()
+    (root / "packs/task_0_pack_0.log").write_text("kage.ppo.train: done\n")
+    for task in TASKS:
+        for unit, seed in task:
+            run = root / "runs" / unit / f"seed_{seed}"
+            (run / "checkpoints").mkdir(parents=True)
+            (run / "checkpoints/latest.pt").write_bytes(b"\0" * 64)
+            (run / "tensorboard").mkdir()
+            (run / "tensorboard/events").write_bytes(b"\1" * 64)
+            (run / "metrics.jsonl").write_text(f'{{"unit": "{unit}", "seed": {seed}}}\n')
+            (run / "summary.json").write_text("{}")
+            (run / "bench_state.json").write_text(json.dumps({"state": state}))
+    return root
+
+
+def pack_new(root, dest, max_files):
+    return subprocess.run([sys.executable, str(PACK_TASK), str(root), "new", str(dest), str(max_files)],
+                          capture_output=True, text=True)
+
+
+def test_new_packs_what_fits_and_ends_with_status_3_for_the_rest(tmp_path):
+    root = benchmark(tmp_path / "bench")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "call.log").write_text("")
+    first = pack_new(root, out, 5)  # the log and two tasks' archive and checksum list
+    assert first.returncode == 3, first.stderr
+    assert "task(s) 2 finished but not packed" in first.stdout
+    assert sorted(p.name for p in out.iterdir()) == [
+        "call.log", "task_0.sha256", "task_0.tar.gz", "task_1.sha256", "task_1.tar.gz"]
+
+    second = pack_new(root, tmp_path / "next_call", 5)  # the next call packs only what is left
+    assert second.returncode == 0, second.stderr
+    assert sorted(p.name for p in (tmp_path / "next_call").iterdir()) == ["task_2.sha256", "task_2.tar.gz"]
+
+    with tarfile.open(out / "task_0.tar.gz") as tar:
+        names = set(tar.getnames())
+    assert {"tasks.json", "bench.json", "suite.json", "packs/task_0_pack_0.log",
+            "runs/a/1/seed_2/metrics.jsonl", "runs/a/1/seed_2/summary.json"} <= names
+    assert not [n for n in names if "checkpoints" in n or "tensorboard" in n]
+    sums = (out / "task_0.sha256").read_text().splitlines()
+    digest = hashlib.sha256((out / "task_0.tar.gz").read_bytes()).hexdigest()
+    assert f"{digest}  task_0.tar.gz" in sums
+
+    packs = tmp_path / "packs"  # as results/kage-bench-table/packs gathers the calls' tasks
+    packs.mkdir()
+    for path in [*out.glob("task_*"), *(tmp_path / "next_call").glob("task_*")]:
+        path.rename(packs / path.name)
+    unpack = subprocess.run([sys.executable, str(UNPACK), str(packs), str(tmp_path / "home")],
+                            capture_output=True, text=True)
+    assert unpack.returncode == 0, unpack.stderr
+    for task in TASKS:
+        for unit, seed in task:
+            metrics = f"runs/{unit}/seed_{seed}/metrics.jsonl"
+            assert (tmp_path / "home" / metrics).read_text() == (root / metrics).read_text()
+
+
+def test_new_waits_until_the_runner_marks_the_runs_done(tmp_path):
+    root = benchmark(tmp_path / "bench", state="running")  # summary.json written, trainer not yet exited
+    result = pack_new(root, tmp_path / "out", 8)
+    assert result.returncode == 0, result.stderr
+    assert not (tmp_path / "out").exists()
+    for state in root.glob("runs/*/*/seed_*/bench_state.json"):
+        state.write_text(json.dumps({"state": "done"}))
+    result = pack_new(root, tmp_path / "out", 8)
+    assert result.returncode == 0, result.stderr
+    assert len(list((tmp_path / "out").glob("task_*.tar.gz"))) == 3
+
+
+def test_an_unfinished_task_is_refused_by_its_runs(tmp_path):
+    root = benchmark(tmp_path / "bench")
+    (root / "runs/a/1/seed_2/summary.json").unlink()
+    result = subprocess.run([sys.executable, str(PACK_TASK), str(root), "0", str(tmp_path / "out")],
+                            capture_output=True, text=True)
+    assert result.returncode != 0
+    assert "task 0 is not finished: no summary.json in runs/a/1/seed_2" in result.stderr
