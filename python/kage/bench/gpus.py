@@ -5,6 +5,7 @@ is left: the same tasks as a Slurm array, resumable the same way, one report.
 
 KAGE_BENCH_FAKE_GPUS=N stands for N GPUs that do not exist, for testing the scheduler on a machine without
 one (with --device cpu): `all` means 0..N-1 and each worker's CUDA_VISIBLE_DEVICES names its fake device."""
+import heapq
 import os
 import signal
 import subprocess
@@ -53,6 +54,17 @@ def parse_gpus(text: str, trainer_device: str) -> List[str]:
     return [visible[i] if visible else str(i) for i in indices]
 
 
+def eta_seconds(task_seconds: float, todo: int, running_elapsed: List[float], workers: int) -> float:
+    """Seconds until the last task ends if each takes task_seconds: the running tasks end first, and the workers
+    take the waiting ones as they come free, as run_on_gpus hands them out."""
+    free = [max(task_seconds - elapsed, 0.0) for elapsed in running_elapsed]
+    free += [0.0] * (workers - len(free))
+    heapq.heapify(free)
+    for _ in range(todo):
+        heapq.heapreplace(free, free[0] + task_seconds)
+    return max(free)
+
+
 def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
     """Trains the unfinished tasks of `table`, one worker per device; prints each task's start and end."""
     todo = [i for i, task in enumerate(table) if not all(map(tasks.is_finished, task))]
@@ -64,8 +76,8 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
     children = {}
     failed: List[int] = []
     stopping = threading.Event()
-    started = time.monotonic()
-    finished = [0]  # tasks trained to the end: a stopped task's time says nothing of the rest's
+    began = {}  # device -> when its task began
+    durations: List[float] = []  # of tasks trained to the end: a stopped task's time says nothing of the rest's
 
     def worker(device: str) -> None:
         while True:
@@ -75,17 +87,23 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
                 index = todo.pop(0)
                 print(f"[gpu {device}] task {index}: {tasks.describe(table[index])}", file=sys.stderr, flush=True)
                 log = open(os.path.join(log_dir, f"task_{index}.log"), "ab")
+                began[device] = time.monotonic()
                 children[device] = subprocess.Popen([*bench.run_command(), "--task", str(index)], stdout=log,
                                                     stderr=log, env=child_environment(CUDA_VISIBLE_DEVICES=device))
             code = children[device].wait()
             log.close()
             with lock:
-                finished[0] += code == 0
+                now = time.monotonic()
+                if code == 0:
+                    durations.append(now - began[device])
                 if code != 0 and not stopping.is_set():
                     failed.append(index)
-                left = len(todo) + sum(c.poll() is None for c in children.values())
-                eta = (f" · ETA {(time.monotonic() - started) / finished[0] * left / 60:,.0f} min"
-                       if finished[0] and not stopping.is_set() else "")
+                running = [now - began[d] for d, child in children.items() if child.poll() is None]
+                left = len(todo) + len(running)
+                eta = ""
+                if durations and not stopping.is_set():
+                    mean = sum(durations) / len(durations)
+                    eta = f" · ETA {eta_seconds(mean, len(todo), running, len(devices)) / 60:,.0f} min"
                 status = ("done" if code == 0 else "stopped" if stopping.is_set()
                           else f"FAILED (exit {code}); see {log.name}")
                 print(f"[gpu {device}] task {index}: {status} · tasks left {left}{eta}", file=sys.stderr, flush=True)
