@@ -76,8 +76,8 @@ def test_an_outer_allocation_maps_the_indices(monkeypatch):
 
 
 def test_the_eta_counts_the_workers_in_parallel():
-    """As when the first of four parallel tasks ends: 600 s a task, three of four GPUs still busy (590, 580 and 100 s
-    in), six tasks waiting. By hand: the GPUs come free at 0, 10, 20 and 500 s; the six waiting tasks take
+    """As when the first of four parallel tasks ends: 600 s a task, three of four GPUs still busy (590, 580 and
+    100 s in), six tasks waiting. By hand: the GPUs come free at 0, 10, 20 and 500 s; the six waiting tasks take
     them in that order and then at 600 and 610 s, so the last ends at 610 + 600 = 1,210 s."""
     assert gpus.eta_seconds(600, 6, [590, 580, 100], 4) == 1210
     assert gpus.eta_seconds(600, 0, [100], 4) == 500  # only the running task's rest
