@@ -32,11 +32,22 @@ def sha256(path: str) -> str:
         return hashlib.file_digest(f, "sha256").hexdigest()
 
 
-def provenance() -> str:
+def trained(root: str, files: list) -> tuple:
+    """When the task's training began and ended, from its runs' own files: a run writes run.json as it starts
+    (never again: a resumed run checks it) and summary.json as it ends."""
+    def times(name: str) -> list:
+        return [os.path.getmtime(os.path.join(root, n)) for n in files if n.endswith("/" + name)]
+    return min(times("run.json")), max(times("summary.json"))
+
+
+def provenance(root: str, files: list) -> str:
     """The checksum list's `#` lines: $KAGE_PACK_PROVENANCE's (device, commit, command; table_device.sh sets
-    it) and the time of packing."""
+    it), the dates of training and of packing."""
     lines = [line for line in os.environ.get(PROVENANCE, "").splitlines() if line.strip()]
-    lines.append(f"date: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} (packed)")
+    began, ended = trained(root, files)
+    day, clock = "%Y-%m-%d %H:%M", "%H:%M"
+    lines.append(f"date: {time.strftime(day, time.gmtime(began))}-{time.strftime(clock, time.gmtime(ended))} "
+                 f"UTC (trained), {time.strftime(clock, time.gmtime())} UTC (packed)")
     return "".join(f"# {line}\n" for line in lines)
 
 
@@ -92,7 +103,7 @@ def pack(root: str, task: int, dest: str) -> None:
         for name in files:
             tar.add(os.path.join(root, name), arcname=name)
     with open(os.path.join(dest, f"task_{task}.sha256"), "w") as f:
-        f.write(provenance())
+        f.write(provenance(root, files))
         f.write(f"{sha256(archive + '.part')}  task_{task}.tar.gz\n")
         f.writelines(f"{sha256(os.path.join(root, n))}  {n}\n" for n in files)
     os.replace(archive + ".part", archive)  # last: a killed call leaves no archive that looks whole

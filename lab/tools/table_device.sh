@@ -19,7 +19,8 @@
 # call at once and is named, for the next call. What the runner has not finished when the lease ends goes with
 # the machine. A task index names the same runs in every lease (kage.bench.tasks), and DIR must be the same path
 # in every lease, since bench.json records it. COMMIT names the tree's commit (the machine gets no .git) for the
-# packs' provenance, beside the device and the command. Run with carry [".deps"]:
+# packs' provenance, beside the device, the command (each call that started the runner, which trained the
+# task), the call that packed it, and when it was trained and packed. Run with carry [".deps"]:
 #   COMMIT=$(git rev-parse --short HEAD) GPUS=all PACK=6 bash lab/tools/table_device.sh
 #   COMMIT=... TASK=0 PACK=6 bash lab/tools/table_device.sh
 set -uo pipefail
@@ -47,11 +48,8 @@ fi
 run=(python3 -m kage.bench run kage_bench --seeds 1-10 --share-training --pack "$PACK" "${scope[@]}" --out "$DIR")
 devices=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | sort | uniq -c |
   sed -E 's/^ *([0-9]+) (.*), ([^,]*)$/\1 x \2 (driver \3)/' | paste -sd ';' -)  # 2 x NVIDIA H200 (driver 580.159.04)
-# The exact call, its settings included, and the runner it drives.
+# The exact call, its settings included: the one that started the runner is the command of what it trains.
 call="COMMIT=$COMMIT ${GPUS:+GPUS=$GPUS }${TASK:+TASK=$TASK }PACK=$PACK LIMIT=$LIMIT bash lab/tools/table_device.sh"
-KAGE_PACK_PROVENANCE=$(printf 'device: %s\ncommit: %s\ncommand: %s (runner: %s %s)' \
-  "$devices" "$COMMIT" "$call" "${run[*]}" "$FLAGS")
-export KAGE_PACK_PROVENANCE
 pack_new() { python3 lab/tools/pack_task.py "$DIR" new "$OUT" "$MAX_FILES" >>"$OUT/call.log"; }
 runner_alive() { [ -s "$DIR/runner.pid" ] && kill -0 "$(cat "$DIR/runner.pid")" 2>/dev/null; }
 mkdir -p "$DIR"
@@ -64,7 +62,12 @@ if ! runner_alive; then  # with every task finished, the runner says so and ends
   # shellcheck disable=SC2016,SC2086
   setsid bash -c 'echo $$ >"$0/runner.pid" && exec "$@"' "$DIR" "${run[@]}" $FLAGS >>"$runner_log" 2>&1 </dev/null &
   for _ in 1 2 3 4 5; do [ -s "$DIR/runner.pid" ] && break; sleep 1; done
+  printf '%s (%s UTC)\n' "$call" "$(date -u +%H:%M)" >>"$DIR/runner.calls"
 fi
+# A runner restarted by a later call (resuming) names each call that started it.
+KAGE_PACK_PROVENANCE=$(printf 'device: %s\ncommit: %s\ncommand: %s, started the runner: %s %s\npacked by: %s' \
+  "$devices" "$COMMIT" "$(paste -sd ';' "$DIR/runner.calls" | sed 's/;/; /g')" "${run[*]}" "$FLAGS" "$call")
+export KAGE_PACK_PROVENANCE
 # A finished task that $OUT has no room for (pack_task's status 3) ends the call at once, for the next to
 # bring home while the lease lasts; so does any other failure of packing, which the log then shows.
 while runner_alive && [ "$SECONDS" -lt $((LIMIT - 25)) ]; do sleep 10; pack_new || break; done  # 25 s: log, status

@@ -1,7 +1,9 @@
 """lab/tools/pack_task.py packs the finished tasks of a benchmark directory for the trip home from a device
 machine, within the files a call brings back, and lab/tools/table_unpack.py unpacks them with their checksums."""
+import calendar
 import hashlib
 import json
+import os
 import subprocess
 import sys
 import tarfile
@@ -11,6 +13,7 @@ from support import ROOT
 PACK_TASK = ROOT / "lab/tools/pack_task.py"
 UNPACK = ROOT / "lab/tools/table_unpack.py"
 TASKS = [[("a/1", 1), ("a/1", 2)], [("b/1", 1)], [("c/1", 1)]]
+TEN_TWENTY_TWO = calendar.timegm((2026, 11, 26, 10, 22, 0))  # UTC
 
 
 def benchmark(root, state="done"):
@@ -30,6 +33,7 @@ def benchmark(root, state="done"):
             (run / "tensorboard").mkdir()
             (run / "tensorboard/events").write_bytes(b"\1" * 64)
             (run / "metrics.jsonl").write_text(f'{{"unit": "{unit}", "seed": {seed}}}\n')
+            (run / "run.json").write_text("{}")
             (run / "summary.json").write_text("{}")
             (run / "bench_state.json").write_text(json.dumps({"state": state}))
     return root
@@ -37,7 +41,8 @@ def benchmark(root, state="done"):
 
 def pack_new(root, dest, max_files):
     return subprocess.run([sys.executable, str(PACK_TASK), str(root), "new", str(dest), str(max_files)],
-                          capture_output=True, text=True)
+                          capture_output=True, text=True,
+                          env={**os.environ, "KAGE_PACK_PROVENANCE": "device: test"})
 
 
 def test_new_packs_what_fits_and_ends_with_status_3_for_the_rest(tmp_path):
@@ -45,6 +50,11 @@ def test_new_packs_what_fits_and_ends_with_status_3_for_the_rest(tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     (out / "call.log").write_text("")
+    # Task 0's first run starts at 10:22, its second at 10:24; they end at 10:31 and 10:35.
+    for seed, (start, end) in ((1, (0, 9)), (2, (2, 13))):
+        run = root / "runs/a/1" / f"seed_{seed}"
+        os.utime(run / "run.json", (TEN_TWENTY_TWO + 60 * start,) * 2)
+        os.utime(run / "summary.json", (TEN_TWENTY_TWO + 60 * end,) * 2)
     first = pack_new(root, out, 5)  # the log and two tasks' archive and checksum list
     assert first.returncode == 3, first.stderr
     assert "task(s) 2 finished but not packed" in first.stdout
@@ -61,6 +71,8 @@ def test_new_packs_what_fits_and_ends_with_status_3_for_the_rest(tmp_path):
             "runs/a/1/seed_2/metrics.jsonl", "runs/a/1/seed_2/summary.json"} <= names
     assert not [n for n in names if "checkpoints" in n or "tensorboard" in n]
     sums = (out / "task_0.sha256").read_text().splitlines()
+    assert sums[0] == "# device: test"
+    assert sums[1].startswith("# date: 2026-11-26 10:22-10:35 UTC (trained), ")  # task 0's times, set below
     digest = hashlib.sha256((out / "task_0.tar.gz").read_bytes()).hexdigest()
     assert f"{digest}  task_0.tar.gz" in sums
 
