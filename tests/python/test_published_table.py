@@ -26,7 +26,7 @@ def test_report_and_compare_run_on_the_published_table(tmp_path):
                             capture_output=True, text=True)
     assert unpack.returncode == 0, unpack.stderr
     runs = packed_runs()
-    assert runs >= 74  # tasks 0 to 12 and 14, published on 2026-11-26; more as the table fills
+    assert runs == 90  # the whole table, tasks 0 to 16, published on 2026-11-26
 
     report = bench("report", str(baseline))
     assert report.returncode == 0, report.stderr
@@ -34,13 +34,14 @@ def test_report_and_compare_run_on_the_published_table(tmp_path):
         written = json.load(f)
     assert written["runs_found"]["finished"] == runs
     pairs_in = sum(p["n_seeds"] > 0 for p in written["levels"]["pairs"])
+    assert pairs_in == 34 and {p["n_seeds"] for p in written["levels"]["pairs"]} == {10}  # all 340 results
 
     shutil.copytree(baseline, tmp_path / "again", ignore=shutil.ignore_patterns("report"))
     compare = bench("compare", str(baseline), str(tmp_path / "again"), "--out", str(tmp_path / "compare"))
     assert compare.returncode == 0, compare.stderr
     # A method against an identical copy of itself: every run ties, so P(X > Y) is exactly one half.
     with open(tmp_path / "compare/improvement.csv") as f:
-        rows = [r for r in csv.DictReader(f) if r["n_pairs"] != "0"]  # axes not yet in the table have no P
+        rows = list(csv.DictReader(f))
     assert [int(r["n_pairs"]) for r in rows if r["scope"] == "all"] == [pairs_in]
     assert {float(r["p"]) for r in rows} == {0.5}
 
