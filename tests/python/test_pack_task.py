@@ -72,7 +72,7 @@ def test_new_packs_what_fits_and_ends_with_status_3_for_the_rest(tmp_path):
     assert not [n for n in names if "checkpoints" in n or "tensorboard" in n]
     sums = (out / "task_0.sha256").read_text().splitlines()
     assert sums[0] == "# device: test"
-    assert sums[1].startswith("# date: 2026-11-26 10:22-10:35 UTC (trained), ")  # task 0's times, set below
+    assert sums[1].startswith("# date: 2026-11-26 10:22-10:35 UTC (trained), ")  # task 0's times, set above
     digest = hashlib.sha256((out / "task_0.tar.gz").read_bytes()).hexdigest()
     assert f"{digest}  task_0.tar.gz" in sums
 
