@@ -39,11 +39,27 @@ def test_nonsense_values_are_refused_before_anything_is_written(tmp_path, flags)
     (["--agent", "kage.ppo.agent:no_such_factory"], []),
     (["--augment", "kage.ppo.augment:no_such_fn"], []),
     (["--num-envs", "100000000", "--num-minibatches", "1", "--total-timesteps", "1600000000"], []),
-], ids=["agent-module", "agent-factory", "augment", "memory"])
-def test_a_refused_run_writes_nothing_and_its_corrected_rerun_trains(tmp_path, first, fix):
+    (["--augment", "bad_plugins:float_frames"], []),
+    (["--augment", "bad_plugins:nothing"], []),
+    (["--augment", "bad_plugins:wrong_shape"], []),
+    (["--augment", "bad_plugins:fewer_rows"], []),
+    (["--augment", "bad_plugins:other_device"], []),
+    (["--augment", "bad_plugins:raises"], []),
+    (["--augment", "bad_plugins:float_frames", "--augment-mode", "rollout"], []),
+    (["--agent", "os:system"], []),
+    (["--agent", "bad_plugins:no_parameters"], []),
+    (["--agent", "bad_plugins:integer_logits"], []),
+    (["--num-envs", "20000", "--num-minibatches", "1", "--total-timesteps", "2560000"], []),
+], ids=["agent-module", "agent-factory", "augment", "memory", "augment-float", "augment-none", "augment-shape",
+        "augment-rows", "augment-device", "augment-raises", "augment-float-rollout", "agent-not-a-factory",
+        "agent-no-parameters", "agent-integer-outputs", "rollout-buffer"])
+def test_a_refused_run_writes_nothing_and_its_corrected_rerun_trains(tmp_path, capsys, first, fix):
     out = tmp_path / "run"
-    with pytest.raises(SystemExit):
+    with pytest.raises(SystemExit) as refused:
         train.main(BASE + ["--device", "cpu", "--out", str(out), *first])
+    message = str(refused.value.code)
+    assert message.startswith("kage.ppo.train:") and "\n" not in message.strip(), message  # one line
+    assert any(flag in message for flag in ("--agent", "--augment", "--num-envs", "memory")), message
     assert not out.exists()
     assert train.main(BASE + ["--device", "cpu", "--out", str(out), *fix]) == 0
     assert json.loads((out / "run.json").read_text())["args"]["device"] == "cpu"

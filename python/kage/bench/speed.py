@@ -5,8 +5,9 @@ Training speed of kage.ppo.train with K runs packed in one process, at the spec'
 pair (seeds 1..K) for a few iterations after a warm-up, then evaluates once, and reports:
 - the aggregate training steps/s (K x 16,384 steps per iteration over the median iteration time);
 - the share of an iteration's GPU timeline spent stepping the environments, in the forward passes
-  (rollout and bootstrap), in the update's forward and loss, in the backward pass and in the optimizer
-  (gradient clipping and Adam), measured with CUDA events (CPU clocks on the CPU), and the rest;
+  (rollout and bootstrap), augmenting frames (--augment), in the update's forward and loss (DrAC's second
+  forward pass included), in the backward pass and in the optimizer (gradient clipping and Adam), measured with
+  CUDA events (CPU clocks on the CPU), and the rest;
 - the time of one evaluation point (128 episodes on each of the two configs, per run);
 - the projected wall time of a pack through a full run (1,525 iterations and 32 evaluation points), per
   run, and for the 340-run table, and the aggregate steps/s of that full run (evaluations counted).
@@ -25,7 +26,7 @@ import torch
 
 from kage.ppo import train
 
-PHASES = ("env", "forward", "update_forward", "backward", "optimizer")
+PHASES = ("env", "forward", "augment", "update_forward", "backward", "optimizer")
 
 
 class PhaseTimer:
@@ -126,9 +127,9 @@ def main(argv: List[str]) -> int:
     flags = " ".join(trainer_args)
     print(f"kage.bench speed: {torch.cuda.get_device_name() if base.device == 'cuda' else 'cpu'}, torch "
           f"{torch.__version__}, {flags}", flush=True)
-    print("| K | steps/s | iteration s | env | forward | update fwd | backward | optimizer | other | eval point s "
-          "| full run h (wall, per pack) | steps/s with evals | GPU h per run | 340 runs GPU h | peak GiB |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
+    print("| K | steps/s | iteration s | env | forward | augment | update fwd | backward | optimizer | other "
+          "| eval point s | full run h (wall, per pack) | steps/s with evals | GPU h per run | 340 runs GPU h | peak GiB |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     with tempfile.TemporaryDirectory() as workdir:
         for packs in [int(k) for k in args.packs.split(",")]:
             try:

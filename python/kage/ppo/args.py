@@ -36,7 +36,15 @@ class Args:
     agent: str = field(default=plugins.BASELINE_AGENT, metadata={
         "help": "module:factory building the policy network (default: the baseline's Nature CNN)"})
     augment: Optional[str] = field(default=None, metadata={
-        "help": "module:fn augmenting the update's minibatches, never evaluations (e.g. kage.ppo.augment:random_shift)"})
+        "help": "module:fn augmenting training frames, never evaluations (e.g. kage.ppo.augment:color_jitter; "
+                "--augment-mode says which frames)"})
+    augment_mode: Optional[str] = field(default=None, metadata={
+        "help": "how --augment trains: drac (the default: PPO on plain frames plus DrAC's policy and value "
+                "regularisers), rollout (the policy acts on augmented frames, and the update reuses them) or update "
+                "(the update's minibatches only: unsound for strong augmentations, kept for comparison)",
+        "choices": ("drac", "rollout", "update")})
+    drac_coef: float = field(default=0.1, metadata={
+        "help": "weight of DrAC's regularisers under --augment-mode drac (alpha_r; 0.1 in Raileanu et al. 2021)"})
     # PPO (§2.1: the defaults of ppo_jax.py; the benchmark overrides none)
     total_timesteps: int = field(default=25_000_000, metadata={"help": "environment steps of the run"})
     learning_rate: float = field(default=5e-4, metadata={"help": "Adam learning rate"})
@@ -111,7 +119,8 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
             parser.add_argument(flag, nargs="+", default=default, help=f.metadata["help"])
         else:
             kind = next(t for t in (int, float, str) if f.type in (t, Optional[t]))
-            parser.add_argument(flag, type=kind, default=default, help=f.metadata["help"])
+            parser.add_argument(flag, type=kind, default=default, help=f.metadata["help"],
+                                choices=f.metadata.get("choices"))
     parser.add_argument("--pack", help="train the runs listed in this JSON file together (written by kage.bench)")
     namespace = vars(parser.parse_args(argv))
     pack = namespace.pop("pack")
@@ -191,6 +200,8 @@ def range_problems(args: Args) -> List[str]:
     need(finite(args.clip_coef) and args.clip_coef > 0, f"--clip-coef {args.clip_coef}: positive and finite")
     need(finite(args.ent_coef) and args.ent_coef >= 0, f"--ent-coef {args.ent_coef}: finite and not negative")
     need(finite(args.vf_coef) and args.vf_coef >= 0, f"--vf-coef {args.vf_coef}: finite and not negative")
+    need(math.isfinite(args.drac_coef) and args.drac_coef >= 0, f"--drac-coef {args.drac_coef}: finite and not "
+         "negative")
     need(args.max_grad_norm > 0, f"--max-grad-norm {args.max_grad_norm}: a positive norm (a negative one would "
          "ascend the gradient; inf turns clipping off)")
     need(not math.isnan(args.reward_clip_min) and not math.isnan(args.reward_clip_max)
@@ -240,6 +251,11 @@ def validate(args: Args) -> List[str]:
     if args.agent != plugins.BASELINE_AGENT and (args.fused_input or args.channels_last or args.triton_conv):
         problems.append("--fused-input, --channels-last and --triton-conv rewrite the baseline's network: drop them "
                         "with --agent")
+    if args.augment_mode and not args.augment:
+        problems.append(f"--augment-mode {args.augment_mode} needs --augment module:fn (e.g. "
+                        "kage.ppo.augment:color_jitter), or drop --augment-mode")
+    elif args.augment_mode not in (None, "drac", "rollout", "update"):
+        problems.append(f"--augment-mode {args.augment_mode!r}: use drac, rollout or update")
     if args.triton_conv and args.device == "cpu":
         problems.append("--triton-conv is for --device cuda")
     if args.triton_conv and not args.fused_input:

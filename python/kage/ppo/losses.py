@@ -1,5 +1,5 @@
 """PPO's arithmetic (kage-ppo-baseline.md §2.5 step 3, §2.6), with any leading run axes: GAE, the clipped
-losses, the entropy coefficient and the per-run gradient clip."""
+losses, the entropy coefficient and the per-run gradient clip; and DrAC's regularisers (--augment-mode drac)."""
 import torch
 
 
@@ -41,6 +41,18 @@ def ppo_loss(new_logprob, entropy, new_value, old_logprob, old_value, advantages
     entropy_loss = entropy.mean(-1)
     loss = pg_loss - ent_coef * entropy_loss + v_loss * args.vf_coef
     return loss, pg_loss, v_loss, entropy_loss, approx_kl, clipfrac
+
+
+def drac_regularisers(logits, value, augmented_logits, augmented_value):
+    """DrAC's regularisers (Raileanu et al. 2021, eq. 4-5), each [K] (a mean over the last axis): G_pi =
+    KL(pi(.|s) || pi(.|aug(s))) and G_V = (V(s) - V(aug(s)))^2, the plain frames' policy and value held fixed, so
+    that the gradient pulls the augmented frames' outputs towards the plain ones (as DrAC's code, which takes
+    them from the rollout without a gradient). The KL is exact over the actions, not sampled."""
+    log_p = torch.log_softmax(logits.detach(), dim=-1)
+    log_q = torch.log_softmax(augmented_logits, dim=-1)
+    policy = (log_p.exp() * (log_p - log_q)).sum(-1).mean(-1)
+    value = ((value.detach() - augmented_value) ** 2).mean(-1)
+    return policy, value
 
 
 def entropy_coefficient(args, optimizer_steps: int) -> float:

@@ -13,10 +13,14 @@ being (H, W, C) of uint8 frames (C = 12 under --use-frame-stack), and returns a 
   [B, A], values [B]). Its runs train one at a time (kage.bench run --pack falls back to lone runs).
 The global torch seed is the run's seed when the factory is called, so its initialisation is reproducible.
 
-An augmentation is called as fn(obs, uniform) on every update minibatch (never on the rollout's or an
-evaluation's observations): obs is uint8 [K, B, H, W, C], uniform(shape) returns [K, *shape] float32
-uniforms in (0, 1) from each run's own counter-based stream (the same numbers alone, packed or resumed);
-it returns uint8 frames of the same shape.
+An augmentation is called as fn(obs, uniform) on training frames, as --augment-mode says (kage.ppo.train):
+the update's minibatches (drac, update) or the rollout's observations (rollout), never an evaluation's.
+obs is uint8 [K, B, H, W, C], uniform(shape) returns [K, *shape] float32 uniforms in (0, 1) from each run's own
+counter-based stream (the same numbers alone, packed or resumed); it returns uint8 frames of the same shape on
+the same device (checked on blank frames before anything is written, and on every call). One that sets
+`fn.takes_frame_indices = True` (as kage.ppo.augment's) is called on update minibatches as fn(frames, uniform,
+images=images), run k's b-th frame being frames.reshape(-1, H, W, C)[images[k, b]], so it may read them where
+the rollout stored them.
 """
 import difflib
 import importlib
@@ -26,6 +30,7 @@ from typing import Callable, List, Optional, Sequence
 import torch
 import torch.nn as nn
 
+from kage.ppo.counter_random import CounterRandom
 from kage.ppo.policy import autocast
 
 BASELINE_AGENT = "kage.ppo.agent:nature_cnn"
@@ -94,22 +99,38 @@ def build_agent(reference: str, observation_shape: Sequence[int], num_actions: i
         raise SystemExit(f"kage.ppo.train: --agent {reference} is not packable (its factory has no `packable = True`): "
                          "train its runs one at a time (kage.bench run does so by itself)")
     torch.manual_seed(seeds[0])
-    net = factory(tuple(observation_shape), num_actions, list(seeds) if packable else seeds[:1], device, **(speed or {}))
+    try:
+        net = factory(tuple(observation_shape), num_actions, list(seeds) if packable else seeds[:1], device,
+                      **(speed or {}))
+    except Exception as e:  # a user's factory: whatever it raises is reported as its failure
+        raise SystemExit(f"kage.ppo.train: --agent {reference}: calling it as factory(observation_shape, num_actions, "
+                         f"seeds, device) raised {type(e).__name__}: {e}; it must build the network "
+                         "(kage.ppo.plugins)") from None
     if not isinstance(net, nn.Module):
         raise SystemExit(f"kage.ppo.train: --agent {reference} returned {type(net).__name__}, not a torch.nn.Module")
+    if not any(p.requires_grad for p in net.parameters()):
+        raise SystemExit(f"kage.ppo.train: --agent {reference} built a network without trainable parameters: PPO "
+                         "has nothing to train")
     if packable and not callable(getattr(net, "run_view", None)):
         raise SystemExit(f"kage.ppo.train: --agent {reference} is packable but its network has no run_view(tensor) "
                          "(see kage.ppo.agent.Agent.run_view)")
     agent = net if packable else LoneRun(net)
     K = len(seeds)
     blank = torch.zeros((K, 2, *observation_shape), dtype=torch.uint8, device=device)
-    with torch.no_grad(), autocast(bool(speed and speed.get("bf16"))):  # as the trainer calls it
-        logits, value = agent(blank)
-    if tuple(logits.shape) != (K, 2, num_actions) or tuple(value.shape) != (K, 2):
+    try:
+        with torch.no_grad(), autocast(bool(speed and speed.get("bf16"))):  # as the trainer calls it
+            output = agent(blank)
+        logits, value = output
+    except Exception as e:
+        raise SystemExit(f"kage.ppo.train: --agent {reference}: its network on a blank batch of uint8 frames "
+                         f"{list(blank.shape)} raised {type(e).__name__}: {e}") from None
+    if not (torch.is_tensor(logits) and torch.is_tensor(value)) or tuple(logits.shape) != (K, 2, num_actions) or \
+            tuple(value.shape) != (K, 2) or not (logits.is_floating_point() and value.is_floating_point()):
         shape = "[K, B, H, W, C] -> [K, B, A], [K, B]" if packable else "[B, H, W, C] -> [B, A], [B]"
-        got = (logits.shape, value.shape) if packable else (logits.shape[1:], value.shape[1:])
+        described = [describe(t, 0 if packable else 1) for t in (logits, value)]
         raise SystemExit(f"kage.ppo.train: --agent {reference}: the network must map {shape} (A = {num_actions} "
-                         f"actions); on a batch of 2 it returned logits {list(got[0])} and values {list(got[1])}")
+                         f"actions, floating point); on a batch of 2 it returned logits {described[0]} and values "
+                         f"{described[1]}")
     return agent
 
 
@@ -128,14 +149,71 @@ def load_augment(reference: Optional[str]) -> Optional[Callable]:
     return fn
 
 
-def augment_draws(random, stream: int, counter: torch.Tensor, optimizer_steps: int) -> Callable:
-    """The uniform(shape) an augmentation draws from on one minibatch: each run's `stream` of `random` (a
-    kage.ppo.counter_random.CounterRandom), the counter naming the optimiser step and the draw, so a run draws
-    the same numbers alone, packed or resumed."""
+def describe(value, lead: int) -> str:
+    """A network output as an error message shows it: a tensor's shape and dtype past `lead` axes, else its type."""
+    if not torch.is_tensor(value):
+        return type(value).__name__
+    return f"{list(value.shape[lead:])} {str(value.dtype).replace('torch.', '')}"
+
+
+def augment_draws(random, stream: int, counter: torch.Tensor, position: int) -> Callable:
+    """The uniform(shape) an augmentation draws from on one batch: each run's `stream` of `random` (a
+    kage.ppo.counter_random.CounterRandom), the counter naming the batch's position (the optimiser step of an
+    update minibatch, the step of a rollout) and the draw, so a run draws the same numbers alone, packed or
+    resumed."""
     draws = 0
 
     def uniform(shape):
         nonlocal draws
         draws += 1
-        return random.uniform(stream, counter.fill_(optimizer_steps * 64 + draws), shape)
+        return random.uniform(stream, counter.fill_(position * 64 + draws), shape)
     return uniform
+
+
+def augment_frames(fn: Callable, reference: str, frames: torch.Tensor, uniform: Callable,
+                   images: Optional[torch.Tensor] = None) -> torch.Tensor:
+    """fn on `frames` (at `images` where given: see the contract above), its output checked: uint8 frames of the
+    input's shape on its device."""
+    if images is not None and getattr(fn, "takes_frame_indices", False) is True:
+        out = fn(frames, uniform, images=images)
+        expected = (*images.shape, *frames.shape[-3:])
+    else:
+        frames = frames if images is None else frames.reshape(-1, *frames.shape[-3:])[images]
+        out = fn(frames, uniform)
+        expected = tuple(frames.shape)
+    problem = augmented_problem(out, expected, frames.device)
+    if problem:
+        raise SystemExit(f"kage.ppo.train: --augment {reference}: {problem}")
+    return out
+
+
+def augmented_problem(out, shape, device) -> Optional[str]:
+    """What is wrong with an augmentation's output, or None."""
+    expected = f"uint8 frames {list(shape)} on {device}"
+    if not torch.is_tensor(out):
+        return f"returned {type(out).__name__}, not {expected}"
+    if out.dtype != torch.uint8:
+        return (f"returned {str(out.dtype).replace('torch.', '')} frames; it must return {expected} (values 0-255, "
+                "as it was given them: the network divides by 255 itself)")
+    if tuple(out.shape) != tuple(shape):
+        return f"returned frames {list(out.shape)}; it must return {expected}"
+    if out.device != torch.device(device):
+        return f"returned frames on {out.device}; it must return {expected}"
+    return None
+
+
+def check_augment(fn: Callable, reference: str, shape, device) -> None:
+    """Calls the augmentation once on blank uint8 frames of the real shape (K runs of 2 frames), alone and, where it
+    reads frames at indices, at indices, so that a wrong output is refused before anything is written."""
+    random = CounterRandom([0] * shape[0], device)
+    counter = torch.zeros((), dtype=torch.int64, device=device)
+    blank = torch.zeros(shape, dtype=torch.uint8, device=device)
+    images = torch.arange(shape[0] * shape[1], device=device).view(shape[0], shape[1])
+    for at in (None, images):
+        try:
+            augment_frames(fn, reference, blank, augment_draws(random, 0, counter, 0), at)
+        except SystemExit:
+            raise
+        except Exception as e:  # a user's function: whatever it raises is reported as its failure
+            raise SystemExit(f"kage.ppo.train: --augment {reference}: on blank uint8 frames {list(shape)} it raised "
+                             f"{type(e).__name__}: {e}") from None

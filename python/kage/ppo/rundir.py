@@ -42,7 +42,7 @@ from kage.util.lock import DirectoryLock, LockHeld
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
 # Arguments added since runs were first written, with the value that means what a run without them did.
-_ADDED_ARGUMENTS = {"agent": "kage.ppo.agent:nature_cnn", "augment": None, "video_every": 0}
+_ADDED_ARGUMENTS = {"agent": "kage.ppo.agent:nature_cnn", "augment": None, "video_every": 0, "drac_coef": 0.1}
 
 
 def code_version() -> str:
@@ -406,9 +406,32 @@ def changed_arguments(before: dict, now: dict) -> List[Tuple[str, object]]:
     """(name, value before) of each argument in `now` that differs from `before` (arguments added since count
     with their earlier meaning; moved module paths name the same code), those a resume may change left out."""
     before = dict(_ADDED_ARGUMENTS, **before)
+    before.setdefault("augment_mode", recorded_mode(before))
     for key in ("agent", "augment"):
         before[key] = plugins.current_reference(before.get(key))
     return [(k, before.get(k)) for k in sorted(now) if k not in _RESUMABLE_CHANGES and before.get(k) != now[k]]
+
+
+def recorded_mode(recorded_args: dict) -> Optional[str]:
+    """The --augment-mode a run's recorded arguments mean: the one recorded, or, for a run started before the flag
+    existed, update (the only mode then) where it had an --augment."""
+    if "augment_mode" in recorded_args:
+        return recorded_args["augment_mode"]
+    return "update" if recorded_args.get("augment") else None
+
+
+def with_augment_mode(args):
+    """`args` with --augment-mode's default made explicit: the mode its run directory was started in, where it
+    has a run.json that records an --augment, else drac whenever --augment is given."""
+    if args.augment_mode or not args.augment:
+        return args
+    mode = "drac"
+    path = os.path.join(args.out or default_dir(args), "run.json")
+    if os.path.isfile(path):
+        recorded, problem = read_json_record(path, run_json_problem)
+        if not problem and recorded["args"].get("augment"):
+            mode = recorded_mode(recorded["args"]) or "drac"
+    return dataclasses.replace(args, augment_mode=mode)
 
 
 def check_same_run(path: str, previous: dict, args: dict, configs: dict) -> None:

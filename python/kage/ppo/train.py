@@ -16,8 +16,13 @@ one makes sense:
   show `success_once`: both are logged.
 Not offered: --target-kl (declared and never read by the original), Weights & Biases.
 
-Your own agent: --agent module:factory builds the network, --augment module:fn transforms the update's
-minibatches (kage.ppo.plugins); the rest of the protocol is the same for every agent. Videos: kage.ppo.video;
+Your own agent: --agent module:factory builds the network, --augment module:fn transforms training frames
+(kage.ppo.plugins; the standard set in kage.ppo.augment) as --augment-mode says: drac (the default) keeps PPO's
+losses on the plain frames and adds DrAC's regularisers (Raileanu et al. 2021) on the augmented minibatch;
+rollout lets the policy act on augmented frames and trains on those same frames; update augments the update's
+minibatches only, so that PPO's ratio compares the policy on augmented frames with the rollout's on plain ones
+(unsound for strong augmentations: kept for comparison). Evaluations always see plain frames. The rest of the
+protocol is the same for every agent. Videos: kage.ppo.video;
 TensorBoard scalars under the original's tags, where tensorboard is importable: kage.ppo.tensorboard_log.
 
 Packing: the loop trains K runs at once (K = 1 for a lone run; `kage.bench run --pack K`). Each run has its
@@ -46,14 +51,16 @@ from kage.ppo.agent import frames_at
 from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args
 from kage.ppo.counter_random import CounterRandom
 from kage.ppo.evaluation import METRICS, EpisodeMetrics, EvalSettings, EvalTargets, evaluation_rows
-from kage.ppo.losses import clip_grad_norm_per_run, compute_gae, entropy_coefficient, entropy_of, ppo_loss
+from kage.ppo.losses import (clip_grad_norm_per_run, compute_gae, drac_regularisers, entropy_coefficient, entropy_of,
+                             ppo_loss)
 from kage.ppo.policy import RolloutPolicy, autocast
 from kage.ppo.wrappers import FrameStack, RewardNormalizer
 from kage.util.files import os_error_text, safe
 from kage.util.stop import StopRequest, die_with_parent
 
 ACTION_STREAM, SHUFFLE_STREAM = 1, 2  # the two random streams of a run (§2.4); evaluations use their own keys
-AUGMENT_STREAM = 3  # --augment's draws (not in the original)
+AUGMENT_STREAM = 3  # --augment's draws on update minibatches (update and drac modes; not in the original)
+ROLLOUT_AUGMENT_STREAM = 4  # its draws on the rollout's frames (rollout mode)
 
 
 # ---- the training loop (§2.5) ----
@@ -64,6 +71,7 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
     where they start (kage.bench speed). Resumes each run from its checkpoint if it has one. Once `stop` is
     requested (a signal), checkpoints after the running iteration and exits. Each run directory is locked from
     its opening to the end (kage.util.lock)."""
+    pack = [rundir.with_augment_mode(a) for a in pack]
     with rundir.held_open():
         return train_locked(pack, timer, stop_after, stop)
 
@@ -75,7 +83,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     timer = timer or NoTimer()
     device, threads = choose_device(args)
     # Everything that can be refused is checked before a run directory is written: the configs, the batches
-    # (their size against the memory), the agent and the augmentation.
+    # (their size against the memory), the agent and the augmentation (each called once on blank frames), and
+    # the rollout's storage against the device's free memory.
     runs = [open_batches(a, threads) for a in pack]
     K, T, N = len(runs), args.num_steps, args.num_envs
     height, width, channels = runs[0].env.single_observation_space.shape
@@ -84,6 +93,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     agent = plugins.build_agent(args.agent, (height, width, channels), num_actions, [a.seed for a in pack], device,
                                 speed_modes(args))  # §2.4: the runs' seeds
     augment = plugins.load_augment(args.augment)
+    if augment:
+        plugins.check_augment(augment, args.augment, (K, 2, height, width, channels), device)
+    check_memory(args, K, (height, width, channels), device)
     # A network that reads a minibatch where the rollout stored it (kage.ppo.agent.Agent) gets the buffer and
     # the frames' indices; any other gets the gathered frames.
     frames_in_place = getattr(agent, "takes_frame_indices", False)
@@ -136,6 +148,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     # so the episode metrics are read once per rollout instead of after every step.
     read_once = min(spec["episode_length"] for spec in specs) >= T
     finished_at = torch.zeros((T, K, N), device=device)
+    augment_minibatch = augment if args.augment_mode in ("update", "drac") else None
+    augment_rollout = RolloutAugment(augment, args.augment, random, T) if args.augment_mode == "rollout" else None
 
     for iteration in range(start_iteration, last_iteration + 1):
         iteration_start = time.perf_counter()
@@ -152,6 +166,10 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                     obs[step] = stack.stack
                 else:
                     torch.stack(frames, out=obs[step])  # the runtime's frames straight into the rollout buffer
+            if augment_rollout:  # the policy acts on, and the update trains on, the same augmented frames
+                with timer("augment"):
+                    obs[step] = augment_rollout(obs[step], iteration, step)
+            with timer("forward"):
                 dones[step] = state.next_done
                 action, logprob, value = rollout(obs[step], noise[:, step])
                 values[step], actions[step], logprobs[step] = value, action, logprob
@@ -169,6 +187,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                         final = torch.stack(final_frames)
                         if stack:  # the final frame on top of the episode's last stack
                             final = torch.cat([stack.stack[..., final.shape[-1]:], final], -1)
+                        if augment_rollout:
+                            final = augment_rollout(final, iteration, step, final=True)
                         reward = reward + args.gamma * agent(final)[1].float() * truncated
                 if normalizer:
                     reward = normalizer(reward, state.next_done)
@@ -181,8 +201,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         state.global_step += args.batch_size  # §2.5 step 2
 
         with torch.no_grad(), timer("forward"):  # §2.5 step 3
+            last = augment_rollout(observe(), iteration, T) if augment_rollout else observe()
             with autocast(args.bf16):
-                next_value = agent(observe())[1].float()
+                next_value = agent(last)[1].float()
             advantages, returns = compute_gae(rewards, values, dones, next_value, state.next_done, args.gamma,
                                               args.gae_lambda)
 
@@ -197,23 +218,17 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
             permutation = random.permutation(SHUFFLE_STREAM, counter, args.batch_size)  # [K, B]
             for start in range(0, args.batch_size, args.minibatch_size):
                 mb = permutation[:, start:start + args.minibatch_size]
+                images = (mb // N * K + runs_axis) * N + mb % N
+                augmented = None
+                if augment_minibatch:
+                    with timer("augment"):
+                        draws = plugins.augment_draws(random, AUGMENT_STREAM, counter, state.optimizer_steps)
+                        augmented = plugins.augment_frames(augment, args.augment, obs, draws, images)
                 with timer("update_forward"):
-                    images = (mb // N * K + runs_axis) * N + mb % N
-                    if frames_in_place and not augment:
-                        inputs = (obs, images)
-                    else:
-                        mb_obs = frames_at(obs, images)
-                        if augment:  # the update's minibatch only: the rollout and evaluations see plain frames
-                            draws = plugins.augment_draws(random, AUGMENT_STREAM, counter, state.optimizer_steps)
-                            mb_obs = augment(mb_obs, draws)
-                        inputs = (mb_obs,)
-                    with autocast(args.bf16):
-                        logits, new_value = agent(*inputs)
-                    logits, new_value = logits.float(), new_value.float()
-                    new_logprob = torch.log_softmax(logits, -1).gather(-1, b_actions[runs_axis, mb, None]).squeeze(-1)
-                    loss, pg_loss, v_loss, entropy, approx_kl, clipfrac = ppo_loss(
-                        new_logprob, entropy_of(logits), new_value, b_logprobs[runs_axis, mb], b_values[runs_axis, mb],
-                        b_advantages[runs_axis, mb], b_returns[runs_axis, mb], args, ent_coef)
+                    plain = (obs, images) if frames_in_place else (frames_at(obs, images),)
+                    loss, terms = minibatch_loss(agent, plain, augmented, b_actions[runs_axis, mb],
+                                                 b_logprobs[runs_axis, mb], b_values[runs_axis, mb],
+                                                 b_advantages[runs_axis, mb], b_returns[runs_axis, mb], args, ent_coef)
                 with timer("backward"):
                     optimizer.zero_grad()
                     loss.sum().backward()  # the runs' losses are independent: each gradient is its run's own
@@ -225,9 +240,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         # §2.5 step 5, §4.3: losses of the last minibatch, named; the host reads them once.
         var_returns = b_returns.var(1, unbiased=False)
         explained_var = 1 - (b_returns - b_values).var(1, unbiased=False) / (var_returns + 1e-8)
-        measured = {"value_loss": v_loss, "policy_loss": pg_loss, "entropy": entropy, "approx_kl": approx_kl,
-                    "clipfrac": clipfrac, "loss": loss, "explained_variance": explained_var,
-                    "var_returns": var_returns, **state.stored_episodes(), "episode_sums": episode_sums}
+        measured = {**terms, "loss": loss, "explained_variance": explained_var, "var_returns": var_returns,
+                    **state.stored_episodes(), "episode_sums": episode_sums}
         timer.end_iteration()
         iteration_seconds = time.perf_counter() - iteration_start
         state.train_seconds += iteration_seconds
@@ -263,6 +277,29 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     return runs
 
 
+def minibatch_loss(agent, plain: tuple, augmented: Optional[torch.Tensor], actions, old_logprob, old_value, advantages,
+                   returns, args: Args, ent_coef: float):
+    """One minibatch's loss [K] (§2.6) as --augment-mode says, and its named terms: PPO's losses on the network's
+    outputs for the plain frames (`plain`: its arguments), or under update on the augmented ones; under drac,
+    + drac_coef (G_pi + G_V) between the plain and the augmented frames' outputs (kage.ppo.losses)."""
+    inputs = (augmented,) if args.augment_mode == "update" and augmented is not None else plain
+    with autocast(args.bf16):
+        logits, value = agent(*inputs)
+    logits, value = logits.float(), value.float()
+    logprob = torch.log_softmax(logits, -1).gather(-1, actions[..., None]).squeeze(-1)
+    loss, pg_loss, v_loss, entropy, approx_kl, clipfrac = ppo_loss(logprob, entropy_of(logits), value, old_logprob,
+                                                                   old_value, advantages, returns, args, ent_coef)
+    terms = {"value_loss": v_loss, "policy_loss": pg_loss, "entropy": entropy, "approx_kl": approx_kl,
+             "clipfrac": clipfrac}
+    if args.augment_mode == "drac" and augmented is not None:
+        with autocast(args.bf16):
+            augmented_logits, augmented_value = agent(augmented)
+        terms["drac_policy"], terms["drac_value"] = drac_regularisers(logits, value, augmented_logits.float(),
+                                                                      augmented_value.float())
+        loss = loss + args.drac_coef * (terms["drac_policy"] + terms["drac_value"])
+    return loss, terms
+
+
 # ---- the runs of a pack ----
 
 @dataclass
@@ -279,22 +316,22 @@ class Run:
 def open_batches(args: Args, threads: int) -> Run:
     """The run's configs resolved and its batches made, each checked to run the resolved Spec; nothing written."""
     specs = rundir.resolve_configs(configs_of(args), args.asset_root)[0]
-    env = make_batch(specs, "train", args.train_config_path, args.num_envs, args, threads, seed=args.seed)
+    env = make_batch(specs, "train", args.train_config_path, args.num_envs, "--num-envs", args, threads, seed=args.seed)
     eval_envs = {}
     if args.run_eval_every > 0 and args.eval_episodes > 0 and args.eval_num_envs > 0:
         for label, path in configs_of(args):
-            eval_envs[label] = make_batch(specs, label, path, args.eval_num_envs, args, threads)
+            eval_envs[label] = make_batch(specs, label, path, args.eval_num_envs, "--eval-num-envs", args, threads)
     return Run(args, specs, env, eval_envs)
 
 
-def make_batch(specs: Dict[str, dict], label: str, path: str, num_envs: int, args: Args, threads: int,
+def make_batch(specs: Dict[str, dict], label: str, path: str, num_envs: int, flag: str, args: Args, threads: int,
                **seed) -> "kage.VecEnv":
-    """A batch of config `label`, checked to run the Spec resolved for it; what make_vec refuses (too large for
-    the memory, no GPU) ends the trainer with its message."""
+    """A batch of config `label` (`num_envs` environments, set by `flag`), checked to run the Spec resolved for it;
+    what make_vec refuses (too large for the memory, no GPU) ends the trainer with its message."""
     try:
         env = kage.make_vec(path, num_envs, device=args.device, asset_root=args.asset_root, threads=threads, **seed)
     except (ValueError, RuntimeError, OSError) as e:
-        raise SystemExit(f"kage.ppo.train: config '{path}' ({label}): {e}") from None
+        raise SystemExit(f"kage.ppo.train: config '{path}' ({label}, {flag} {num_envs}): {e}") from None
     rundir.check_env(specs, label, env)
     return env
 
@@ -335,6 +372,39 @@ def speed_modes(args: Args) -> Optional[dict]:
         return None
     return {"bf16": args.bf16, "channels_last": args.channels_last, "fused_input": args.fused_input,
             "triton_conv": args.triton_conv}
+
+
+class RolloutAugment:
+    """--augment-mode rollout: the augmentation of the frames the policy acts on, each draw named by the iteration,
+    the step and whether it is a truncation's final frame, so a run draws the same numbers alone, packed or
+    resumed."""
+
+    def __init__(self, augment, reference: str, random: CounterRandom, num_steps: int):
+        self.augment, self.reference, self.random, self.num_steps = augment, reference, random, num_steps
+        self.counter = torch.zeros((), dtype=torch.int64, device=random.device)
+
+    def __call__(self, frames: torch.Tensor, iteration: int, step: int, final: bool = False) -> torch.Tensor:
+        position = ((iteration - 1) * (self.num_steps + 1) + step) * 2 + final
+        draws = plugins.augment_draws(self.random, ROLLOUT_AUGMENT_STREAM, self.counter, position)
+        return plugins.augment_frames(self.augment, self.reference, frames, draws)
+
+
+def check_memory(args: Args, runs: int, frame_shape, device) -> None:
+    """Refuses a rollout whose storage (frames, actions, log-probabilities, rewards, dones, values, finished
+    marks, and the frames of an update minibatch) does not fit the device's free memory."""
+    T, N = args.num_steps, args.num_envs
+    frame = math.prod(frame_shape)
+    needed = T * runs * N * (frame + 8 + 6 * 4) + runs * args.minibatch_size * frame * (2 if args.augment else 1)
+    if device.type == "cuda":
+        free = torch.cuda.mem_get_info(device)[0]
+        where = f"the GPU has {free / 2**30:.1f} GiB free"
+    else:
+        free = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        where = f"the machine has {free / 2**30:.1f} GiB available"
+    if needed > 0.9 * free:
+        raise SystemExit(f"kage.ppo.train: the rollout's storage needs {needed / 2**30:.1f} GiB ({T} steps x {runs} "
+                         f"run{'s' if runs > 1 else ''} x {N} environments of {'x'.join(map(str, frame_shape))} "
+                         f"frames), and {where}: lower --num-envs or --num-steps, or pack fewer runs")
 
 
 class NoTimer:
@@ -535,7 +605,8 @@ def train_rows(measured: List[Dict[str, object]], iteration: int, global_step: i
                "charts/learning_rate": learning_rate, "charts/entropy_coef": ent_coef,
                "charts/SPS": global_step / train_seconds, "charts/SPS_update": args.batch_size / iteration_seconds}
         row.update({f"losses/{name}": m[name] for name in
-                    ("value_loss", "policy_loss", "entropy", "approx_kl", "clipfrac", "loss")})
+                    ("value_loss", "policy_loss", "entropy", "approx_kl", "clipfrac", "loss", "drac_policy",
+                     "drac_value") if name in m})
         if m["var_returns"] > 0:
             row["train/explained_variance"] = m["explained_variance"]
         if m["any_finished"]:
@@ -559,7 +630,7 @@ def main(argv: Optional[List[str]] = None) -> int:
 def train_command(argv: Optional[List[str]]) -> int:
     """main() without its handling of file-system errors."""
     parsed = parse_args(argv)
-    pack = parsed if isinstance(parsed, list) else [parsed]
+    pack = [rundir.with_augment_mode(a) for a in (parsed if isinstance(parsed, list) else [parsed])]
     unfinished = []
     for args in pack:
         path = args.out or rundir.default_dir(args)

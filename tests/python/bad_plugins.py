@@ -1,0 +1,49 @@
+"""Plug-ins that break the contract (kage.ppo.plugins), each refused before the trainer writes anything
+(tests/python/test_checks_before_writing.py)."""
+import torch
+import torch.nn as nn
+
+
+def float_frames(obs, uniform):
+    return obs.float() / 255  # frames in [0, 1]: the network would divide by 255 twice
+
+
+def nothing(obs, uniform):
+    return None
+
+
+def wrong_shape(obs, uniform):
+    return obs[..., :64, :, :]
+
+
+def fewer_rows(obs, uniform):
+    return obs[:, :1]
+
+
+def other_device(obs, uniform):
+    return obs.to("meta")
+
+
+def raises(obs, uniform):
+    raise RuntimeError("this augmentation is broken")
+
+
+class NoParameters(nn.Module):
+    def forward(self, obs):
+        return torch.zeros((*obs.shape[:-3], 8)), torch.zeros(obs.shape[:-3])
+
+
+def no_parameters(observation_shape, num_actions, seeds, device):
+    return NoParameters()
+
+
+def integer_logits(observation_shape, num_actions, seeds, device):
+    """A network whose outputs are integers: refused, as PPO needs floating-point logits and values."""
+    class Net(nn.Module):
+        def __init__(self):
+            super().__init__()
+            self.w = nn.Parameter(torch.zeros(()))
+
+        def forward(self, obs):
+            return torch.zeros((obs.shape[0], num_actions), dtype=torch.long), torch.zeros(obs.shape[0], dtype=torch.long)
+    return Net()
