@@ -76,9 +76,28 @@ def test_an_outer_allocation_maps_the_indices(monkeypatch):
 
 
 def test_the_eta_counts_the_workers_in_parallel():
-    """As when the first of four parallel tasks ends: 600 s a task, three of four GPUs still busy (590, 580 and
-    100 s in), six tasks waiting. By hand: the GPUs come free at 0, 10, 20 and 500 s; the six waiting tasks take
-    them in that order and then at 600 and 610 s, so the last ends at 610 + 600 = 1,210 s."""
-    assert gpus.eta_seconds(600, 6, [590, 580, 100], 4) == 1210
-    assert gpus.eta_seconds(600, 0, [100], 4) == 500  # only the running task's rest
-    assert gpus.eta_seconds(100, 3, [], 1) == 300  # one GPU: one task after another
+    """As when the first of four parallel tasks ends: 600 s a task (weight 60 at 10 s a unit), three of four GPUs
+    still busy (590, 580 and 100 s in), six tasks waiting. By hand: the GPUs come free at 0, 10, 20 and 500 s; the
+    six waiting tasks take them in that order and then at 600 and 610 s, so the last ends at 610 + 600 = 1,210 s."""
+    assert gpus.eta_seconds(10, [60] * 6, [(60, 590), (60, 580), (60, 100)], 4) == 1210
+    assert gpus.eta_seconds(10, [], [(60, 100)], 4) == 500  # only the running task's rest
+    assert gpus.eta_seconds(100, [1, 1, 1], [], 1) == 300  # one GPU: one task after another
+    # Tasks of other weights, handed out longest first to 2 GPUs at 1 s a unit: 50 and 40 start at 0; 30 takes
+    # the GPU free at 40 (ends 70); 20 the one free at 50 (ends 70); 10 the one free at 70: the last ends at 80.
+    assert gpus.eta_seconds(1, [50, 40, 30, 20, 10], [], 2) == 80
+
+
+def test_tasks_are_handed_out_longest_first():
+    """A task's weight is, per run, its configs (train and evals) plus its training (TRAINING_AS_CONFIGS); the
+    heaviest task goes first, ties in table order."""
+    from types import SimpleNamespace
+    unit = lambda evals: SimpleNamespace(evals=["e"] * evals)  # noqa: E731
+    table = [[(unit(1), 1, "a")] * 6, [(unit(9), 1, "b")] * 4, [(unit(1), 1, "c")] * 2, [(unit(5), 1, "d")] * 6,
+             [(unit(5), 2, "e")] * 6]
+    weights = [gpus.task_weight(task) for task in table]
+    assert weights == [6 * (2 + gpus.TRAINING_AS_CONFIGS), 4 * (10 + gpus.TRAINING_AS_CONFIGS),
+                       2 * (2 + gpus.TRAINING_AS_CONFIGS), 6 * (6 + gpus.TRAINING_AS_CONFIGS),
+                       6 * (6 + gpus.TRAINING_AS_CONFIGS)]
+    # 72, 80, 24, 96, 96 at TRAINING_AS_CONFIGS = 10: tasks 3 and 4 tie (table order), then 1, 0 and 2
+    assert gpus.longest_first(table, [0, 1, 2, 3, 4]) == [3, 4, 1, 0, 2]
+    assert gpus.longest_first(table, [0, 2]) == [0, 2]

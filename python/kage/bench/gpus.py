@@ -1,5 +1,6 @@
 """kage.bench run --gpus all|0,2,...: every GPU of one host busy until the benchmark is done. One worker per
-GPU takes the next unfinished task of the task table and trains it in a child process
+GPU takes the longest unfinished task left (task_weight: its runs times the configs each evaluates, plus its
+training), so that the GPUs finish together, and trains it in a child process
 (`kage.bench run ... --task I`, its log in DIR/tasks/task_<I>.log) that sees that GPU alone, until no task
 is left: the same tasks as a Slurm array, resumable the same way, one report.
 
@@ -54,20 +55,39 @@ def parse_gpus(text: str, trainer_device: str) -> List[str]:
     return [visible[i] if visible else str(i) for i in indices]
 
 
-def eta_seconds(task_seconds: float, todo: int, running_elapsed: List[float], workers: int) -> float:
-    """Seconds until the last task ends if each takes task_seconds: the running tasks end first, and the workers
-    take the waiting ones as they come free, as run_on_gpus hands them out."""
-    free = [max(task_seconds - elapsed, 0.0) for elapsed in running_elapsed]
+# A run's training costs about as much as evaluating this many configs over its 32 evaluation points: on 4 x H100
+# (results/kage-bench-table/leases/2026-11-26-h100x4-2.md) a pack of 6 runs with 7 configs each trained in 448 s
+# and evaluated in 321 s, 7.6 s per run and config.
+TRAINING_AS_CONFIGS = 10
+
+
+def task_weight(task: List[tasks.Job]) -> int:
+    """A task's expected time in units of one run's evaluation of one config: per run, its configs (the train
+    config and its eval configs) plus its training (TRAINING_AS_CONFIGS)."""
+    return sum(1 + len(unit.evals) + TRAINING_AS_CONFIGS for unit, _, _ in task)
+
+
+def longest_first(table: List[List[tasks.Job]], indices: List[int]) -> List[int]:
+    """The task indices, the heaviest first (task_weight), ties in table order: the longest-processing-time-first
+    schedule, whose GPUs end close together."""
+    return sorted(indices, key=lambda i: -task_weight(table[i]))
+
+
+def eta_seconds(unit_seconds: float, waiting: List[int], running: List[tuple], workers: int) -> float:
+    """Seconds until the last task ends if a task of weight w takes w * unit_seconds: the running tasks ((weight,
+    seconds elapsed) each) end first, and the workers take the waiting tasks (their weights, in the order they are
+    handed out) as they come free, as run_on_gpus does."""
+    free = [max(weight * unit_seconds - elapsed, 0.0) for weight, elapsed in running]
     free += [0.0] * (workers - len(free))
     heapq.heapify(free)
-    for _ in range(todo):
-        heapq.heapreplace(free, free[0] + task_seconds)
+    for weight in waiting:
+        heapq.heapreplace(free, free[0] + weight * unit_seconds)
     return max(free)
 
 
 def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
     """Trains the unfinished tasks of `table`, one worker per device; prints each task's start and end."""
-    todo = [i for i, task in enumerate(table) if not all(map(tasks.is_finished, task))]
+    todo = longest_first(table, [i for i, task in enumerate(table) if not all(map(tasks.is_finished, task))])
     print(f"kage.bench run: {len(table)} tasks, {len(table) - len(todo)} finished earlier; {len(todo)} to train on "
           f"GPUs {','.join(devices)}", file=sys.stderr, flush=True)
     log_dir = os.path.join(bench.out, "tasks")
@@ -76,8 +96,8 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
     children = {}
     failed: List[int] = []
     stopping = threading.Event()
-    began = {}  # device -> when its task began
-    durations: List[float] = []  # of tasks trained to the end: a stopped task's time says nothing of the rest's
+    began = {}  # device -> (its task's weight, when it began)
+    finished_time, finished_weight = [0.0], [0]  # of tasks trained to the end: a stopped task says nothing
 
     def worker(device: str) -> None:
         while True:
@@ -87,7 +107,7 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
                 index = todo.pop(0)
                 print(f"[gpu {device}] task {index}: {tasks.describe(table[index])}", file=sys.stderr, flush=True)
                 log = open(os.path.join(log_dir, f"task_{index}.log"), "ab")
-                began[device] = time.monotonic()
+                began[device] = (task_weight(table[index]), time.monotonic())
                 children[device] = subprocess.Popen([*bench.run_command(), "--task", str(index)], stdout=log,
                                                     stderr=log, env=child_environment(CUDA_VISIBLE_DEVICES=device))
             code = children[device].wait()
@@ -95,15 +115,17 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
             with lock:
                 now = time.monotonic()
                 if code == 0:
-                    durations.append(now - began[device])
+                    finished_time[0] += now - began[device][1]
+                    finished_weight[0] += began[device][0]
                 if code != 0 and not stopping.is_set():
                     failed.append(index)
-                running = [now - began[d] for d, child in children.items() if child.poll() is None]
+                running = [(began[d][0], now - began[d][1]) for d, child in children.items() if child.poll() is None]
                 left = len(todo) + len(running)
                 eta = ""
-                if durations and not stopping.is_set():
-                    mean = sum(durations) / len(durations)
-                    eta = f" · ETA {eta_seconds(mean, len(todo), running, len(devices)) / 60:,.0f} min"
+                if finished_weight[0] and not stopping.is_set():
+                    unit_seconds = finished_time[0] / finished_weight[0]
+                    waiting = [task_weight(table[i]) for i in todo]
+                    eta = f" · ETA {eta_seconds(unit_seconds, waiting, running, len(devices)) / 60:,.0f} min"
                 status = ("done" if code == 0 else "stopped" if stopping.is_set()
                           else f"FAILED (exit {code}); see {log.name}")
                 print(f"[gpu {device}] task {index}: {status} · tasks left {left}{eta}", file=sys.stderr, flush=True)
