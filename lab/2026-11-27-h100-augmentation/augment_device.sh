@@ -23,10 +23,13 @@ LIMIT=${LIMIT:-570}
 mkdir -p "$RUNS"
 if [ -n "${CHECK:-}" ]; then
   python3 -m pytest -q -p no:cacheprovider tests/gpu/test_augment_gpu.py 2>&1 | tail -15 | tee "$OUT/gpu_tests.txt"
+  # shellcheck disable=SC2086
+  python3 -m kage.bench speed --packs ${CHECK_PACKS:-2} --warmup 1 --iterations 2 --device cuda $FAST 2>&1 |
+    tail -1 | tee -a "$OUT/smoke.txt"
   for mode in update rollout drac; do
     # shellcheck disable=SC2086
-    python3 -m kage.bench speed --packs 2 --warmup 1 --iterations 1 --device cuda $FAST \
-      --augment kage.ppo.augment:color_jitter --augment-mode "$mode" 2>&1 | tail -3 | tee -a "$OUT/smoke.txt"
+    python3 -m kage.bench speed --packs ${CHECK_PACKS:-2} --warmup 1 --iterations 2 --device cuda $FAST \
+      --augment kage.ppo.augment:color_jitter --augment-mode "$mode" 2>&1 | tail -1 | tee -a "$OUT/smoke.txt"
   done
   exit 0
 fi

@@ -43,9 +43,26 @@ def takes_frame_indices(fn: Callable) -> Callable:
     return fn
 
 
+# No tensor is made from Python values on the device per call: such a copy from pageable memory waits for the
+# stream's queued work, which would stall the rollout at every step. Constants are made once per device.
+@functools.lru_cache(maxsize=8)
+def _constants(device: torch.device) -> dict:
+    yiq = torch.tensor([[0.299, 0.587, 0.114], [0.596, -0.274, -0.322], [0.211, -0.523, 0.312]], dtype=torch.float64)
+    return {"luma": torch.tensor(LUMA).to(device), "eye": torch.eye(3).to(device),
+            "yiq": yiq.float().to(device), "yiq_inverse": torch.linalg.inv(yiq).float().to(device)}
+
+
 def _integers(u: torch.Tensor, n) -> torch.Tensor:
-    """Uniforms in (0, 1) -> integers in [0, n) (n a number or a tensor of them), as float32."""
-    return torch.minimum(torch.floor(u * n), torch.as_tensor(n, dtype=torch.float32, device=u.device) - 1)
+    """Uniforms in (0, 1) -> integers in [0, n) (n a number or a float32 tensor of them), as float32."""
+    if torch.is_tensor(n):
+        return torch.minimum(torch.floor(u * n), n - 1)
+    return torch.floor(u * n).clamp(max=n - 1)
+
+
+def _pair(k: int, b: int, first: float, second: float, device) -> torch.Tensor:
+    """[K, B, 2] float32 holding (first, second) in every row."""
+    return torch.stack([torch.full((k, b), float(first), device=device), torch.full((k, b), float(second),
+                                                                                     device=device)], -1)
 
 
 def _normals(uniform, shape) -> torch.Tensor:
@@ -66,30 +83,27 @@ def random_shift(obs: torch.Tensor, uniform, images: Optional[torch.Tensor] = No
     rows and columns (replicate padding, then the crop)."""
     k, b, h, w = _frame_shape(obs, images)
     offsets = (uniform((b, 2)) * (2 * PAD + 1)).long().clamp(max=2 * PAD) - PAD  # [K, B, 2]
-    window = torch.tensor([h, w], device=obs.device).expand(k, b, 2)
-    return apply(obs, Plan(remap=torch.cat([offsets, window], -1).float()), images)
+    return apply(obs, Plan(remap=torch.cat([offsets.float(), _pair(k, b, h, w, obs.device)], -1)), images)
 
 
 @takes_frame_indices
 def random_crop(obs: torch.Tensor, uniform, images: Optional[torch.Tensor] = None) -> torch.Tensor:
     """A window of CROP of each side at a random position, resized back to the frame by nearest neighbour."""
     k, b, h, w = _frame_shape(obs, images)
-    window = torch.tensor([round(CROP * h), round(CROP * w)], dtype=torch.float32, device=obs.device)
-    origin = _integers(uniform((b, 2)), torch.tensor([h, w], device=obs.device) - window + 1)
-    return apply(obs, Plan(remap=torch.cat([origin, window.expand(k, b, 2)], -1)), images)
+    window = _pair(k, b, round(CROP * h), round(CROP * w), obs.device)
+    origin = _integers(uniform((b, 2)), _pair(k, b, h, w, obs.device) - window + 1)
+    return apply(obs, Plan(remap=torch.cat([origin, window], -1)), images)
 
 
 def _hue_matrices(angle: torch.Tensor) -> torch.Tensor:
     """[..., 3, 3] rotations of the chroma plane of YIQ by `angle` (radians), in RGB: a hue shift that keeps luma
     and maps grey to itself."""
-    yiq = torch.tensor([[0.299, 0.587, 0.114], [0.596, -0.274, -0.322], [0.211, -0.523, 0.312]],
-                       dtype=torch.float64)
-    rotation = torch.zeros((*angle.shape, 3, 3), dtype=torch.float64, device=angle.device)
-    cos, sin = torch.cos(angle.double()), torch.sin(angle.double())
+    constants = _constants(angle.device)
+    rotation = torch.zeros((*angle.shape, 3, 3), device=angle.device)
+    cos, sin = torch.cos(angle), torch.sin(angle)
     rotation[..., 0, 0] = 1
     rotation[..., 1, 1], rotation[..., 1, 2], rotation[..., 2, 1], rotation[..., 2, 2] = cos, -sin, sin, cos
-    yiq = yiq.to(angle.device)
-    return (torch.linalg.inv(yiq) @ rotation @ yiq).float()
+    return constants["yiq_inverse"] @ rotation @ constants["yiq"]
 
 
 @takes_frame_indices
@@ -102,9 +116,9 @@ def color_jitter(obs: torch.Tensor, uniform, images: Optional[torch.Tensor] = No
     bright, contrast, saturation = (1 + JITTER[name] * (2 * u[..., i] - 1)
                                     for i, name in enumerate(("brightness", "contrast", "saturation")))
     angle = 2 * math.pi * JITTER["hue"] * (2 * u[..., 3] - 1)
-    luma = torch.tensor(LUMA, device=obs.device)
-    eye = torch.eye(3, device=obs.device)
-    saturate = saturation[..., None, None] * eye + (1 - saturation)[..., None, None] * luma.expand(3, 3)
+    constants = _constants(obs.device)
+    saturate = saturation[..., None, None] * constants["eye"] + \
+        (1 - saturation)[..., None, None] * constants["luma"].expand(3, 3)
     matrix = _hue_matrices(angle) @ saturate * (contrast * bright)[..., None, None]
     # Saturation and hue map grey to grey, so the contrast's pivot passes through them unchanged.
     offset = ((1 - contrast) * bright * gray_means(obs, images))[..., None].expand(k, b, 3)
@@ -116,8 +130,8 @@ def grayscale(obs: torch.Tensor, uniform, images: Optional[torch.Tensor] = None)
     """With probability GRAYSCALE_P a frame's luma in all three channels, else the frame as it is."""
     k, b, _, _ = _frame_shape(obs, images)
     gray = (uniform((b,)) < GRAYSCALE_P).float()[..., None, None]
-    luma = torch.tensor(LUMA, device=obs.device).expand(3, 3)
-    matrix = gray * luma + (1 - gray) * torch.eye(3, device=obs.device)
+    constants = _constants(obs.device)
+    matrix = gray * constants["luma"].expand(3, 3) + (1 - gray) * constants["eye"]
     colour = torch.cat([matrix.reshape(k, b, 9), torch.zeros((k, b, 3), device=obs.device)], -1)
     return apply(obs, Plan(colour=colour), images)
 
@@ -137,7 +151,7 @@ def cutout_color(obs: torch.Tensor, uniform, images: Optional[torch.Tensor] = No
     position inside the frame, filled with a random colour."""
     k, b, h, w = _frame_shape(obs, images)
     u = uniform((b, 7))
-    side = torch.tensor([h, w], dtype=torch.float32, device=obs.device)
+    side = _pair(k, b, h, w, obs.device)
     low, high = torch.round(CUTOUT_SIDES[0] * side), torch.round(CUTOUT_SIDES[1] * side)
     size = low + _integers(u[..., 0:2], high - low)
     origin = _integers(u[..., 2:4], side - size + 1)
