@@ -47,3 +47,20 @@ def test_kernel_equals_reference_on_the_gpu(monkeypatch, name, channels):
     on_reference(monkeypatch)
     check(got_batch, fn(batch, draws()), name in EXACT)
     check(got_minibatch, fn(buffer, draws(), images=images), name in EXACT)
+
+
+@pytest.mark.parametrize("name", sorted(augment.STANDARD))
+def test_the_rollouts_graph_replays_the_eager_augmentation(name):
+    """--augment-mode rollout under --cuda-graph: the captured augmentation of a step's frames equals the eager one
+    at every position (iteration, step, final frame)."""
+    from kage.ppo.train import RolloutAugment
+    fn = augment.STANDARD[name]
+    shape = (3, 64, 128, 128, 3)
+    random = CounterRandom([1, 2, 3], "cuda")
+    graphed = RolloutAugment(fn, name, random, 128, shape, torch.device("cuda"), cuda_graph=True)
+    eager = RolloutAugment(fn, name, random, 128, shape, torch.device("cuda"), cuda_graph=False)
+    assert graphed.graph is not None, "the standard set must be capturable"
+    generator = torch.Generator("cuda").manual_seed(3)
+    for iteration, step, final in ((1, 0, False), (1, 5, True), (7, 128, False)):
+        frames = torch.randint(0, 256, shape, dtype=torch.uint8, device="cuda", generator=generator)
+        assert torch.equal(graphed(frames, iteration, step, final).clone(), eager(frames, iteration, step, final))

@@ -149,7 +149,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     read_once = min(spec["episode_length"] for spec in specs) >= T
     finished_at = torch.zeros((T, K, N), device=device)
     augment_minibatch = augment if args.augment_mode in ("update", "drac") else None
-    augment_rollout = RolloutAugment(augment, args.augment, random, T) if args.augment_mode == "rollout" else None
+    augment_rollout = RolloutAugment(augment, args.augment, random, T, observe().shape, device,
+                                     args.cuda_graph) if args.augment_mode == "rollout" else None
 
     for iteration in range(start_iteration, last_iteration + 1):
         iteration_start = time.perf_counter()
@@ -377,16 +378,49 @@ def speed_modes(args: Args) -> Optional[dict]:
 class RolloutAugment:
     """--augment-mode rollout: the augmentation of the frames the policy acts on, each draw named by the iteration,
     the step and whether it is a truncation's final frame, so a run draws the same numbers alone, packed or
-    resumed."""
+    resumed. The position is a device tensor, so that under --cuda-graph the augmentation of a step's frames is
+    captured once and replayed (a step's few dozen small launches cost more than its frames' pass); one that
+    cannot be captured runs eagerly, and the trainer says so."""
 
-    def __init__(self, augment, reference: str, random: CounterRandom, num_steps: int):
+    def __init__(self, augment, reference: str, random: CounterRandom, num_steps: int, shape, device,
+                 cuda_graph: bool):
         self.augment, self.reference, self.random, self.num_steps = augment, reference, random, num_steps
-        self.counter = torch.zeros((), dtype=torch.int64, device=random.device)
+        self.position = torch.zeros((), dtype=torch.int64, device=device)
+        self.graph = None
+        if cuda_graph:
+            self.frames = torch.zeros(shape, dtype=torch.uint8, device=device)
+            side = torch.cuda.Stream()
+            side.wait_stream(torch.cuda.current_stream())
+            with torch.cuda.stream(side):
+                for _ in range(2):  # warm-up: kernels compiled, constants and images loaded outside the capture
+                    self._augment(self.frames)
+            torch.cuda.current_stream().wait_stream(side)
+            graph = torch.cuda.CUDAGraph()
+            try:
+                with torch.cuda.graph(graph):
+                    self.augmented = self._augment(self.frames)
+                self.graph = graph
+            except Exception as e:  # a function that reads values on the host, or allocates outside torch
+                print(f"kage.ppo.train: --augment {reference} cannot be replayed as a CUDA graph ({type(e).__name__}: "
+                      f"{str(e).splitlines()[0] if str(e) else ''}); it runs eagerly", file=sys.stderr, flush=True)
+
+    def _augment(self, frames: torch.Tensor) -> torch.Tensor:
+        base = self.position * 64
+        draws = 0
+
+        def uniform(shape):
+            nonlocal draws
+            draws += 1
+            return self.random.uniform(ROLLOUT_AUGMENT_STREAM, base + draws, shape)
+        return plugins.augment_frames(self.augment, self.reference, frames, uniform)
 
     def __call__(self, frames: torch.Tensor, iteration: int, step: int, final: bool = False) -> torch.Tensor:
-        position = ((iteration - 1) * (self.num_steps + 1) + step) * 2 + final
-        draws = plugins.augment_draws(self.random, ROLLOUT_AUGMENT_STREAM, self.counter, position)
-        return plugins.augment_frames(self.augment, self.reference, frames, draws)
+        self.position.fill_(((iteration - 1) * (self.num_steps + 1) + step) * 2 + final)
+        if self.graph is None:
+            return self._augment(frames)
+        self.frames.copy_(frames)
+        self.graph.replay()
+        return self.augmented
 
 
 def check_memory(args: Args, runs: int, frame_shape, device) -> None:
