@@ -3,9 +3,10 @@
 # - CHECK=1 (any machine, one call): the build, tests/gpu/test_augment_gpu.py, and two iterations of the fast path
 #   with color_jitter in each mode (kage.bench speed --packs 2), so that a mistake costs one short call;
 # - otherwise the runner: three learning checks, IMAGE_SKELETON trained with color_jitter under update, rollout
-#   and drac (seeds 1-4, one pack, evaluated on the nine filters pairs' eval configs, the table's flags, full
-#   length) on GPUs 0-2, and the speed table on GPU 3 (kage.bench speed --packs 16 with the table's flags: the
-#   plain fast path, then each shipped augmentation under update, rollout and drac, then the plain path again).
+#   and drac (seeds 1-4, one pack, evaluated on the nine filters pairs' eval configs, the table's flags, STEPS
+#   steps: 10 M by default, what one lease holds beside the speed table) on GPUs 0-2, and the speed table
+#   (kage.bench speed --packs 16 with the table's flags: the plain fast path, then each shipped augmentation under
+#   update, rollout and drac, then the plain path again) on GPU 3, and on GPUs 0-2 once their check has ended.
 #   It runs in a process session of its own (setsid) from a copy of the tree made by the first call, so it
 #   trains on through the lease's calls; each call waits up to LIMIT seconds, then brings home what is there:
 #   per mode a tarball of its runs' logs and report (no checkpoints), the learning summaries, the speed rows.
@@ -33,27 +34,46 @@ if [ -n "${CHECK:-}" ]; then
   done
   exit 0
 fi
+cat "$OUT/gpu.txt" >>"$OUT/call.log" && rm -f "$OUT/gpu.txt" "$OUT/build.log"  # one log: the build passed
 pairs=(filters/1 filters/2 filters/3 filters/4 filters/5 filters/6 filters/7 filters/8 filters/9)
+STEPS=${STEPS:-10000000}
 runner_alive() { [ -s "$RUNS/runner.pid" ] && kill -0 "$(cat "$RUNS/runner.pid")" 2>/dev/null; }
 if [ ! -e "$RUNS/runner.pid" ]; then
-  cat >"$RUNS/runner.sh" <<RUNNER
-gpu=0
-for mode in update rollout drac; do
-  CUDA_VISIBLE_DEVICES=\$gpu python3 -m kage.bench run kage_bench --pairs ${pairs[*]} --seeds 1-4 --share-training \
-    --pack 4 --device cuda $FAST --augment kage.ppo.augment:color_jitter --augment-mode \$mode \
-    --out $RUNS/\$mode >$RUNS/\$mode.log 2>&1 &
-  gpu=\$((gpu + 1))
-done
-(
-  flags="--packs 16 --device cuda $FAST --json $RUNS/speed.jsonl"
-  python3 -m kage.bench speed \$flags
+  # The speed table's jobs (kage.bench speed --packs 16, the table's flags): the plain fast path, each shipped
+  # augmentation under update, rollout and drac, and the plain path again; GPU 3 takes them from the start, GPUs 0-2
+  # once their learning check has ended, each job claimed by one worker (mkdir).
+  jobs=("")
   for name in random_shift random_crop color_jitter grayscale random_conv cutout_color gaussian_noise overlay; do
-    for mode in update rollout drac; do
-      python3 -m kage.bench speed \$flags --augment kage.ppo.augment:\$name --augment-mode \$mode
-    done
+    for mode in update rollout drac; do jobs+=("--augment kage.ppo.augment:$name --augment-mode $mode"); done
   done
-  python3 -m kage.bench speed \$flags
-) >$RUNS/speed.log 2>&1 &
+  jobs+=("")
+  printf '%s\n' "${jobs[@]}" >"$RUNS/speed_jobs.txt"
+  mkdir -p "$RUNS/claimed"
+  cat >"$RUNS/runner.sh" <<RUNNER
+speed_worker() {
+  local gpu=\$1 index=0
+  while IFS= read -r flags; do
+    if mkdir "$RUNS/claimed/\$index" 2>/dev/null; then
+      echo "gpu \$gpu: speed job \$index (\$(date -u +%H:%M:%S)): \$flags"
+      CUDA_VISIBLE_DEVICES=\$gpu python3 -m kage.bench speed --packs 16 --device cuda $FAST --json $RUNS/speed.jsonl \
+        \$flags 2>&1 | grep '^| 16'
+    fi
+    index=\$((index + 1))
+  done <"$RUNS/speed_jobs.txt"
+}
+learn_then_speed() {
+  local gpu=\$1 mode=\$2
+  CUDA_VISIBLE_DEVICES=\$gpu python3 -m kage.bench run kage_bench --pairs ${pairs[*]} --seeds 1-4 --share-training \
+    --pack 4 --device cuda $FAST --total-timesteps $STEPS --augment kage.ppo.augment:color_jitter \
+    --augment-mode \$mode --out $RUNS/\$mode >$RUNS/\$mode.log 2>&1
+  echo "gpu \$gpu: \$mode learning check ended (\$(date -u +%H:%M:%S))"
+  speed_worker \$gpu
+}
+learn_then_speed 0 update >>$RUNS/speed.log 2>&1 &
+learn_then_speed 1 rollout >>$RUNS/speed.log 2>&1 &
+learn_then_speed 2 drac >>$RUNS/speed.log 2>&1 &
+(CUDA_VISIBLE_DEVICES=3 python3 -m pytest -q -p no:cacheprovider tests/gpu/test_augment_gpu.py >$RUNS/gpu_tests.txt 2>&1
+ speed_worker 3) >>$RUNS/speed.log 2>&1 &
 wait
 date -u +%H:%M:%S >$RUNS/done
 RUNNER
@@ -71,6 +91,6 @@ for mode in update rollout drac; do
   tail -3 "$RUNS/$mode.log" | tr '\r' '\n' | tail -2 >>"$OUT/call.log"
   tar -czf "$OUT/$mode.tar.gz" -C "$RUNS" --exclude checkpoints --exclude tensorboard --exclude videos "$mode" "$mode.log"
 done
-cp "$RUNS/speed.log" "$RUNS/speed.jsonl" "$OUT/" 2>/dev/null
+cp "$RUNS/speed.log" "$RUNS/speed.jsonl" "$RUNS/gpu_tests.txt" "$OUT/" 2>/dev/null
 if [ -e "$RUNS/done" ]; then echo "augment_device: the runner ended at $(cat "$RUNS/done") UTC" >>"$OUT/call.log"
 else echo "augment_device: the runner trains on ($(date -u +%H:%M:%S) UTC); call again" >>"$OUT/call.log"; fi
