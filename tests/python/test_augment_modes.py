@@ -45,6 +45,7 @@ ADVANTAGES, RETURNS = torch.tensor([[1.0, -0.5]]), torch.tensor([[1.0, 0.0]])
 # The rollout's log-probabilities and values: the policy on the plain frames.
 OLD_LOGPROB = torch.tensor([[math.log(sigmoid(0.2)), math.log(1 - sigmoid(0.4))]])
 OLD_VALUE = torch.tensor([[0.4, 0.8]])
+VAR_RETURNS = torch.tensor([0.25])  # the run's returns' variance over its batch: G_V in units of 0.5
 
 
 def loss_of(mode, augmented):
@@ -52,7 +53,7 @@ def loss_of(mode, augmented):
                       clip_vloss=False, ent_coef=0.0, vf_coef=0.5, clip_coef=0.2)
     agent = Means()
     loss, terms = train.minibatch_loss(agent, (PLAIN,), augmented, ACTIONS, OLD_LOGPROB, OLD_VALUE, ADVANTAGES,
-                                       RETURNS, args, 0.0)
+                                       RETURNS, VAR_RETURNS, args, 0.0)
     return loss.item(), {k: v.item() for k, v in terms.items()}, agent.seen
 
 
@@ -69,7 +70,7 @@ def test_drac_trains_ppo_on_the_plain_frames_and_pulls_the_augmented_outputs_to_
     assert terms["policy_loss"] == pytest.approx(-0.25) and terms["value_loss"] == pytest.approx(0.25)
     assert terms["approx_kl"] == pytest.approx(0.0, abs=1e-7) and terms["clipfrac"] == 0.0
     g_pi = (kl(0.2, 0.8) + kl(0.4, 0.6)) / 2
-    g_v = ((0.4 - 1.6) ** 2 + (0.8 - 1.2) ** 2) / 2  # (V(s) - V(aug s))^2 = 1.44 and 0.16
+    g_v = ((0.4 - 1.6) ** 2 + (0.8 - 1.2) ** 2) / 2 / 0.25  # (V(s) - V(aug s))^2 = 1.44 and 0.16, over 0.25
     assert terms["drac_policy"] == pytest.approx(g_pi, rel=1e-5) and terms["drac_value"] == pytest.approx(g_v)
     assert loss == pytest.approx(-0.25 + 0.5 * 0.25 + 0.1 * (g_pi + g_v), rel=1e-5)
 
@@ -79,13 +80,14 @@ def test_drac_regularisers_move_only_the_augmented_outputs():
     plain_logits, augmented_logits = (agent(frames)[0].detach().clone().requires_grad_() for frames in (PLAIN, AUGMENTED))
     plain_value, augmented_value = (torch.tensor([[0.4, 0.8]], requires_grad=True),
                                     torch.tensor([[1.6, 1.2]], requires_grad=True))
-    policy, value = drac_regularisers(plain_logits, plain_value, augmented_logits, augmented_value)
+    policy, value = drac_regularisers(plain_logits, plain_value, augmented_logits, augmented_value,
+                                      torch.tensor([4.0]))
     (policy + value).sum().backward()
     assert plain_logits.grad is None and plain_value.grad is None  # held fixed
     # d KL / d q's logits = q - p (softmax logits [m, 0]), over 2 frames: frame 0's first logit
     assert augmented_logits.grad[0, 0, 0].item() == pytest.approx((sigmoid(0.8) - sigmoid(0.2)) / 2, rel=1e-5)
-    # d (V - V')^2 / d V' = 2 (V' - V), over 2 frames
-    assert augmented_value.grad[0].tolist() == pytest.approx([1.6 - 0.4, 1.2 - 0.8])
+    # d (V - V')^2 / 4 / d V' = 2 (V' - V) / 4, over 2 frames
+    assert augmented_value.grad[0].tolist() == pytest.approx([(1.6 - 0.4) / 4, (1.2 - 0.8) / 4])
 
 
 def test_update_compares_the_augmented_policy_with_the_rollouts_plain_one():

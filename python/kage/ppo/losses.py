@@ -43,15 +43,21 @@ def ppo_loss(new_logprob, entropy, new_value, old_logprob, old_value, advantages
     return loss, pg_loss, v_loss, entropy_loss, approx_kl, clipfrac
 
 
-def drac_regularisers(logits, value, augmented_logits, augmented_value):
+def drac_regularisers(logits, value, augmented_logits, augmented_value, var_returns):
     """DrAC's regularisers (Raileanu et al. 2021, eq. 4-5), each [K] (a mean over the last axis): G_pi =
-    KL(pi(.|s) || pi(.|aug(s))) and G_V = (V(s) - V(aug(s)))^2, the plain frames' policy and value held fixed, so
-    that the gradient pulls the augmented frames' outputs towards the plain ones (as DrAC's code, which takes
-    them from the rollout without a gradient). The KL is exact over the actions, not sampled."""
+    KL(pi(.|s) || pi(.|aug(s))) and G_V = (V(s) - V(aug(s)))^2 / var_returns, the plain frames' policy and value
+    held fixed, so that the gradient pulls the augmented frames' outputs towards the plain ones (as DrAC's code,
+    which takes them from the rollout without a gradient). The KL is exact over the actions, not sampled.
+
+    G_V is measured in units of the returns' standard deviation (var_returns [K]: each run's over its batch): DrAC's
+    Procgen runs, whose alpha_r = 0.1 this keeps, normalised rewards by the returns' running standard deviation
+    (VecNormalize), so their values were in those units. KAGE's returns run to thousands without normalisation,
+    and the raw squared difference then outweighed PPO's own terms and collapsed every seed of IMAGE_SKELETON with
+    colour jitter to a deterministic policy within 40 iterations (lab/2026-11-27-h100-augmentation)."""
     log_p = torch.log_softmax(logits.detach(), dim=-1)
     log_q = torch.log_softmax(augmented_logits, dim=-1)
     policy = (log_p.exp() * (log_p - log_q)).sum(-1).mean(-1)
-    value = ((value.detach() - augmented_value) ** 2).mean(-1)
+    value = ((value.detach() - augmented_value) ** 2).mean(-1) / (var_returns + 1e-8)
     return policy, value
 
 

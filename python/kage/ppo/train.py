@@ -213,6 +213,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         b_logprobs, b_actions, b_advantages, b_returns, b_values = (
             t.transpose(0, 1).reshape(K, T * N) for t in (logprobs, actions, advantages, returns, values))
         runs_axis = torch.arange(K, device=device)[:, None]
+        var_returns = b_returns.var(1, unbiased=False)  # [K]: DrAC's value term is in units of its root
         for epoch in range(args.update_epochs):
             ent_coef = entropy_coefficient(args, state.optimizer_steps)
             counter.fill_((iteration - 1) * args.update_epochs + epoch)
@@ -229,7 +230,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                     plain = (obs, images) if frames_in_place else (frames_at(obs, images),)
                     loss, terms = minibatch_loss(agent, plain, augmented, b_actions[runs_axis, mb],
                                                  b_logprobs[runs_axis, mb], b_values[runs_axis, mb],
-                                                 b_advantages[runs_axis, mb], b_returns[runs_axis, mb], args, ent_coef)
+                                                 b_advantages[runs_axis, mb], b_returns[runs_axis, mb], var_returns,
+                                                 args, ent_coef)
                 with timer("backward"):
                     optimizer.zero_grad()
                     loss.sum().backward()  # the runs' losses are independent: each gradient is its run's own
@@ -239,7 +241,6 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                 state.optimizer_steps += 1
 
         # §2.5 step 5, §4.3: losses of the last minibatch, named; the host reads them once.
-        var_returns = b_returns.var(1, unbiased=False)
         explained_var = 1 - (b_returns - b_values).var(1, unbiased=False) / (var_returns + 1e-8)
         measured = {**terms, "loss": loss, "explained_variance": explained_var, "var_returns": var_returns,
                     **state.stored_episodes(), "episode_sums": episode_sums}
@@ -279,10 +280,11 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
 
 
 def minibatch_loss(agent, plain: tuple, augmented: Optional[torch.Tensor], actions, old_logprob, old_value, advantages,
-                   returns, args: Args, ent_coef: float):
+                   returns, var_returns, args: Args, ent_coef: float):
     """One minibatch's loss [K] (§2.6) as --augment-mode says, and its named terms: PPO's losses on the network's
     outputs for the plain frames (`plain`: its arguments), or under update on the augmented ones; under drac,
-    + drac_coef (G_pi + G_V) between the plain and the augmented frames' outputs (kage.ppo.losses)."""
+    + drac_coef (G_pi + G_V) between the plain and the augmented frames' outputs (kage.ppo.losses), G_V in units
+    of var_returns [K], the variance of each run's returns over its batch."""
     inputs = (augmented,) if args.augment_mode == "update" and augmented is not None else plain
     with autocast(args.bf16):
         logits, value = agent(*inputs)
@@ -296,7 +298,7 @@ def minibatch_loss(agent, plain: tuple, augmented: Optional[torch.Tensor], actio
         with autocast(args.bf16):
             augmented_logits, augmented_value = agent(augmented)
         terms["drac_policy"], terms["drac_value"] = drac_regularisers(logits, value, augmented_logits.float(),
-                                                                      augmented_value.float())
+                                                                      augmented_value.float(), var_returns)
         loss = loss + args.drac_coef * (terms["drac_policy"] + terms["drac_value"])
     return loss, terms
 

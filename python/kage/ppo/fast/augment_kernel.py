@@ -18,9 +18,10 @@ GRAY_BLOCK = 1024
 
 @triton.jit
 def _mix32(x):
-    """kage.ppo.counter_random.mix32 on int64 values in [0, 2**32)."""
-    x = (((x >> 16) ^ x) * 0x45D9F3B) & 0xFFFFFFFF
-    x = (((x >> 16) ^ x) * 0x45D9F3B) & 0xFFFFFFFF
+    """kage.ppo.counter_random.mix32 on uint32 values: its products modulo 2**32 are uint32 products, which the GPU
+    multiplies natively (int64 products are emulated)."""
+    x = ((x >> 16) ^ x) * 0x45D9F3B
+    x = ((x >> 16) ^ x) * 0x45D9F3B
     return (x >> 16) ^ x
 
 
@@ -71,7 +72,24 @@ def plan_kernel(frames_ptr, images_ptr, rows_ptr, pictures_ptr, out_ptr,
     v0 = tl.zeros([BLOCK_E], dtype=tl.float32)
     v1 = tl.zeros([BLOCK_E], dtype=tl.float32)
     v2 = tl.zeros([BLOCK_E], dtype=tl.float32)
-    if CONV:
+    if CONV and not COLOUR:  # the element's own output channel alone: a third of the products
+        for dy in tl.static_range(3):
+            for dx in tl.static_range(3):
+                py = y + (dy - 1)
+                px = x + (dx - 1)
+                inside = ok & (py >= 0) & (py < H) & (px >= 0) & (px < W)
+                sy, sx = _source(tl.minimum(tl.maximum(py, 0), H - 1), tl.minimum(tl.maximum(px, 0), W - 1), row,
+                                 H, W, REMAP)
+                at = base + (sy * W + sx) * C + group
+                for i in tl.static_range(3):
+                    p = tl.load(at + i, mask=inside, other=0).to(tl.float32)
+                    tap = CONV_AT + i * 9 + dy * 3 + dx
+                    weight = tl.where(j == 0, tl.load(row + tap), tl.where(j == 1, tl.load(row + tap + 27),
+                                                                              tl.load(row + tap + 54)))
+                    v0 += weight * p
+        v1 = v0
+        v2 = v0
+    elif CONV:
         for dy in tl.static_range(3):
             for dx in tl.static_range(3):
                 py = y + (dy - 1)
@@ -100,9 +118,9 @@ def plan_kernel(frames_ptr, images_ptr, rows_ptr, pictures_ptr, out_ptr,
     v = tl.where(j == 0, v0, tl.where(j == 1, v1, v2))
     if NOISE:
         sigma = tl.load(row + NOISE_AT)
-        key1 = tl.load(row + NOISE_AT + 1).to(tl.int64)
-        key2 = tl.load(row + NOISE_AT + 2).to(tl.int64)
-        index = e.to(tl.int64)
+        key1 = tl.load(row + NOISE_AT + 1).to(tl.uint32)
+        key2 = tl.load(row + NOISE_AT + 2).to(tl.uint32)
+        index = e.to(tl.uint32)
         u1 = _uniform(2 * index, key1, key2)
         u2 = _uniform(2 * index + 1, key1, key2)
         v += sigma * (tl.sqrt(-2.0 * tl.log(u1)) * tl.cos(6.283185307179586 * u2))
