@@ -72,24 +72,7 @@ def plan_kernel(frames_ptr, images_ptr, rows_ptr, pictures_ptr, out_ptr,
     v0 = tl.zeros([BLOCK_E], dtype=tl.float32)
     v1 = tl.zeros([BLOCK_E], dtype=tl.float32)
     v2 = tl.zeros([BLOCK_E], dtype=tl.float32)
-    if CONV and not COLOUR:  # the element's own output channel alone: a third of the products
-        for dy in tl.static_range(3):
-            for dx in tl.static_range(3):
-                py = y + (dy - 1)
-                px = x + (dx - 1)
-                inside = ok & (py >= 0) & (py < H) & (px >= 0) & (px < W)
-                sy, sx = _source(tl.minimum(tl.maximum(py, 0), H - 1), tl.minimum(tl.maximum(px, 0), W - 1), row,
-                                 H, W, REMAP)
-                at = base + (sy * W + sx) * C + group
-                for i in tl.static_range(3):
-                    p = tl.load(at + i, mask=inside, other=0).to(tl.float32)
-                    tap = CONV_AT + i * 9 + dy * 3 + dx
-                    weight = tl.where(j == 0, tl.load(row + tap), tl.where(j == 1, tl.load(row + tap + 27),
-                                                                              tl.load(row + tap + 54)))
-                    v0 += weight * p
-        v1 = v0
-        v2 = v0
-    elif CONV:
+    if CONV:
         for dy in tl.static_range(3):
             for dx in tl.static_range(3):
                 py = y + (dy - 1)
