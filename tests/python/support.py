@@ -11,6 +11,11 @@ LONG_EPISODE = str(CONFIGS / "long_episode.yaml")
 NEAR_GOAL = str(CONFIGS / "near_goal.yaml")
 # A config with a stochastic filter, sprites and short episodes.
 NOISY_SKELETON = str(CONFIGS / "noisy_short.yaml")
+# Two runs of a pack (kage.ppo.train.Args fields): each trains on one near-goal config and evaluates on the other.
+NEAR_GOAL_RUNS = [dict(train_config_path=str(CONFIGS / "near_goal.yaml"),
+                       eval_config_path=str(CONFIGS / "near_goal_red.yaml"), seed=3),
+                  dict(train_config_path=str(CONFIGS / "near_goal_red.yaml"),
+                       eval_config_path=str(CONFIGS / "near_goal.yaml"), seed=8)]
 
 
 def policy(seed: int, num_envs: int, steps: int) -> np.ndarray:

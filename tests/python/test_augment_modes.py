@@ -15,7 +15,7 @@ import recording_plugins
 from kage.ppo import checkpoint, train
 from kage.ppo.losses import drac_regularisers
 from kage.util.stop import StopRequest
-from support import CONFIGS, NOISY_SKELETON
+from support import NEAR_GOAL_RUNS as RUNS, NOISY_SKELETON
 
 
 # ---- the loss on one minibatch, by hand ----
@@ -150,10 +150,6 @@ def test_augment_mode_defaults_to_drac(tmp_path):
 
 SMALL = dict(device="cpu", threads=1, total_timesteps=96, num_envs=2, num_steps=16, num_minibatches=2, update_epochs=2,
              run_eval_every=3, eval_episodes=2, eval_num_envs=2, save_checkpoint_every=1)
-RUNS = [dict(train_config_path=str(CONFIGS / "near_goal.yaml"), eval_config_path=str(CONFIGS / "near_goal_red.yaml"),
-             seed=3),
-        dict(train_config_path=str(CONFIGS / "near_goal_red.yaml"), eval_config_path=str(CONFIGS / "near_goal.yaml"),
-             seed=8)]
 MODES = [("kage.ppo.augment:color_jitter", "drac"), ("kage.ppo.augment:random_conv", "rollout"),
          ("kage.ppo.augment:overlay", "update")]
 

@@ -16,14 +16,10 @@ import json
 import pytest
 
 from kage.ppo import checkpoint, train
-from support import CONFIGS
+from support import NEAR_GOAL_RUNS as RUNS
 
 FLAGS = dict(device="cpu", threads=1, total_timesteps=192, num_envs=2, num_steps=16, num_minibatches=2, update_epochs=2,
              run_eval_every=3, eval_episodes=2, eval_num_envs=2, save_checkpoint_every=3)
-RUNS = [dict(train_config_path=str(CONFIGS / "near_goal.yaml"), eval_config_path=str(CONFIGS / "near_goal_red.yaml"),
-             seed=3),
-        dict(train_config_path=str(CONFIGS / "near_goal_red.yaml"), eval_config_path=str(CONFIGS / "near_goal.yaml"),
-             seed=8)]
 EXACT_PREFIXES = ("train/avg_", "charts/learning_rate", "charts/entropy_coef")
 
 
