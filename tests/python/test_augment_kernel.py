@@ -16,8 +16,16 @@ import torch  # noqa: E402
 from triton.runtime.interpreter import InterpretedFunction  # noqa: E402
 
 from kage.ppo import augment  # noqa: E402
+from kage.ppo import augment_plan  # noqa: E402
 from kage.ppo.augment_plan import Plan, reference  # noqa: E402
 from kage.ppo.fast import augment_kernel  # noqa: E402
+
+
+def on_kernel(frames, plan, images=None):
+    """augment_kernel.apply on a plan, as augment_plan.apply calls it on the GPU."""
+    count = images.numel() if images is not None else frames.shape[0] * frames.shape[1]
+    return augment_kernel.apply(frames, plan.rows(count, frames.device), set(plan.stages()), augment_plan.SLOTS,
+                                plan.images, images)
 
 
 @pytest.fixture(autouse=True)
@@ -78,7 +86,7 @@ STAGE_SETS = [("remap",), ("conv",), ("colour",), ("noise",), ("overlay",), ("cu
 def test_the_kernel_follows_the_reference_on_a_batch(stages, channels):
     batch = frames((2, 3, 9, 11, channels))
     plan = plan_of(stages, 6, 9, 11)
-    check(augment_kernel.apply(batch, plan), reference(batch, plan), exact=set(stages) <= {"remap", "cutout"})
+    check(on_kernel(batch, plan), reference(batch, plan), exact=set(stages) <= {"remap", "cutout"})
 
 
 @pytest.mark.parametrize("stages", STAGE_SETS, ids=lambda s: "+".join(s))
@@ -86,7 +94,7 @@ def test_the_kernel_reads_a_minibatch_where_the_rollout_stored_it(stages):
     buffer = frames((3, 2, 4, 9, 11, 3))  # [T, K, N, H, W, C]
     images = torch.tensor([[0, 5, 23], [17, 17, 2]])
     plan = plan_of(stages, 6, 9, 11, seed=4)
-    check(augment_kernel.apply(buffer, plan, images), reference(buffer, plan, images),
+    check(on_kernel(buffer, plan, images), reference(buffer, plan, images),
           exact=set(stages) <= {"remap", "cutout"})
 
 
@@ -94,21 +102,19 @@ def test_the_kernel_reads_a_minibatch_where_the_rollout_stored_it(stages):
 def test_gray_means_follow_the_reference(channels):
     buffer = frames((3, 2, 4, 9, 11, channels))
     images = torch.tensor([[0, 5, 23], [17, 17, 2]])
-    from kage.ppo import augment_plan
     want = augment_plan.gray_means(buffer.reshape(-1, 9, 11, channels)[images])  # the CPU's path
     assert torch.allclose(augment_kernel.gray_means(buffer, images), want, rtol=1e-5)
 
 
 def test_each_standard_augmentation_runs_as_a_kernel(monkeypatch):
     """The standard set through the kernels (as on the GPU) equals its CPU path."""
-    from kage.ppo import augment_plan
     from kage.ppo.counter_random import CounterRandom
     from kage.ppo.plugins import augment_draws
     batch = frames((2, 3, 16, 16, 3))
     for name, fn in sorted(augment.STANDARD.items()):
         draws = lambda: augment_draws(CounterRandom([1, 2], "cpu"), 3, torch.zeros((), dtype=torch.int64), 0)  # noqa
         on_cpu = fn(batch, draws())
-        monkeypatch.setattr(augment_plan, "apply", lambda f, p, i=None: augment_kernel.apply(f, p, i))
+        monkeypatch.setattr(augment_plan, "apply", on_kernel)
         monkeypatch.setattr(augment_plan, "gray_means", lambda f, i=None: augment_kernel.gray_means(f, i))
         monkeypatch.setattr(augment, "apply", augment_plan.apply)
         monkeypatch.setattr(augment, "gray_means", augment_plan.gray_means)

@@ -63,7 +63,9 @@ def apply(frames: torch.Tensor, plan: Plan, images: Optional[torch.Tensor] = Non
                          "frames (3 channels, or a stack of them)")
     if frames.is_cuda and _kernel_available():
         from kage.ppo.fast import augment_kernel
-        return augment_kernel.apply(frames, plan, images)
+        count = images.numel() if images is not None else frames.shape[0] * frames.shape[1]
+        return augment_kernel.apply(frames, plan.rows(count, frames.device), set(plan.stages()), SLOTS, plan.images,
+                                    images)
     return reference(frames, plan, images)
 
 

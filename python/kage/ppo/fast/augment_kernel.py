@@ -1,16 +1,15 @@
 """kage.ppo.augment_plan's pass as Triton kernels: one program per frame and block of its elements, uint8 in
 and out, the frame read where it lies (the rollout buffer, at a minibatch's indices) so that the gather and
 the augmentation are one pass. The stages are constexpr switches: a plan compiles to a kernel with only its
-own stages. kage.ppo.augment_plan.reference is the definition; tests/python/test_augment_kernel.py checks the
-kernels against it under Triton's interpreter, tests/gpu/test_augment_gpu.py on the GPU.
+own stages. kage.ppo.augment_plan.reference is the definition, and augment_plan.apply calls these with a
+plan's parameter rows (this module imports nothing of it); tests/python/test_augment_kernel.py checks the kernels
+against it under Triton's interpreter, tests/gpu/test_augment_gpu.py on the GPU.
 """
-from typing import Optional
+from typing import Dict, Optional, Set, Tuple
 
 import torch
 import triton
 import triton.language as tl
-
-from kage.ppo.augment_plan import ROW, SLOTS, Plan
 
 BLOCK = 1024
 GRAY_BLOCK = 1024
@@ -150,23 +149,23 @@ def _frames_and_count(frames: torch.Tensor, images: Optional[torch.Tensor]):
     return frames, k, b
 
 
-def apply(frames: torch.Tensor, plan: Plan, images: Optional[torch.Tensor] = None) -> torch.Tensor:
-    """kage.ppo.augment_plan.apply on the GPU."""
+def apply(frames: torch.Tensor, rows: torch.Tensor, stages: Set[str], slots: Dict[str, Tuple[int, int]],
+          pictures: Optional[torch.Tensor], images: Optional[torch.Tensor] = None) -> torch.Tensor:
+    """kage.ppo.augment_plan.apply on the GPU: `rows` [F, width] float32 the frames' parameters, `stages` the
+    plan's stages, `slots` each stage's (start, width) in a row, `pictures` the overlay's images."""
     frames, k, b = _frames_and_count(frames, images)
     h, w, c = frames.shape[-3:]
     count = k * b
     out = torch.empty((k, b, h, w, c), dtype=torch.uint8, device=frames.device)
-    rows = plan.rows(count, frames.device)
-    stages = plan.stages()
-    pictures = plan.images if plan.images is not None else rows
     if count:
         plan_kernel[(count, triton.cdiv(h * w * c, BLOCK))](
-            frames, images.contiguous() if images is not None else rows, rows, pictures, out,
-            H=h, W=w, C=c, ROW_WIDTH=ROW, GATHER=images is not None,
+            frames, images.contiguous() if images is not None else rows, rows,
+            pictures if pictures is not None else rows, out,
+            H=h, W=w, C=c, ROW_WIDTH=rows.shape[1], GATHER=images is not None,
             REMAP="remap" in stages, CONV="conv" in stages, COLOUR="colour" in stages, NOISE="noise" in stages,
             OVERLAY="overlay" in stages, CUTOUT="cutout" in stages,
-            CONV_AT=SLOTS["conv"][0], COLOUR_AT=SLOTS["colour"][0], NOISE_AT=SLOTS["noise"][0],
-            OVERLAY_AT=SLOTS["overlay"][0], CUTOUT_AT=SLOTS["cutout"][0], BLOCK_E=BLOCK, num_warps=4)
+            CONV_AT=slots["conv"][0], COLOUR_AT=slots["colour"][0], NOISE_AT=slots["noise"][0],
+            OVERLAY_AT=slots["overlay"][0], CUTOUT_AT=slots["cutout"][0], BLOCK_E=BLOCK, num_warps=4)
     return out
 
 
