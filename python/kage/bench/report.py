@@ -71,7 +71,7 @@ from kage.bench import intervals, plots
 from kage.bench.records import bench_problem
 from kage.bench.units import Unit, units_of
 from kage.bench.tables import METRICS, PROTOCOL_TEXTS, SUCCESS_SHOWN, write_tables
-from kage.util.files import atomic_write, output_folder, safe
+from kage.util.files import LOG_LIMIT, RECORD_LIMIT, atomic_write, open_regular, output_folder, read_regular, safe
 
 DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # as kage.ppo.train logs
 PROTOCOLS = ("max", "final")
@@ -96,12 +96,14 @@ class Run:
 
 
 def read_json(path: str, remedy: str):
+    """A JSON record of at most RECORD_LIMIT bytes in a regular file, or one line naming `path` and `remedy`."""
     try:
-        with open(path, encoding="utf-8") as f:
-            return json.load(f)
+        return json.loads(read_regular(path, RECORD_LIMIT))
     except FileNotFoundError:
         fail(f"{path} not found: {remedy}")
-    except (OSError, ValueError) as e:
+    except OSError as e:  # NotRegularFile too: a FIFO, a device (a symlink to /dev/zero), too large
+        fail(f"{path}: {e.strerror or e}: {remedy}")
+    except (ValueError, RecursionError) as e:
         fail(f"{path} is not readable JSON ({e}): {remedy}")
 
 
@@ -177,34 +179,49 @@ def read_summary(path: str) -> dict:
     return stats
 
 
+MAX_LINE = 64 << 20  # bytes of one log row: a real one is a few KB
+
+
 def read_evaluations(path: str) -> List[dict]:
     """The evaluation rows of a metrics.jsonl. A last line that does not parse is a row the run was
-    killed while writing, and is skipped; a damaged line before it is an error."""
+    killed while writing, and is skipped; a damaged line before it is an error. The file must be a regular
+    file of at most LOG_LIMIT bytes, read a line at a time."""
+    redo = "delete the run directory and rerun `python3 -m kage.bench run` to train the run again"
+    rows: List[dict] = []
+    torn: Optional[int] = None  # a line that did not parse: an error unless it is the last
     try:
-        with open(path, "rb") as f:
-            lines = f.read().decode("utf-8", errors="replace").splitlines()
-    except OSError as e:
-        fail(f"cannot read {path} ({e}): make it readable, or delete the run directory and rerun it")
-    rows = []
-    for number, line in enumerate(lines, start=1):
-        if not line.strip():
-            continue
-        try:
-            row = json.loads(line)
-        except ValueError:
-            if number == len(lines):
-                break
-            fail(f"{path}, line {number}: not a JSON row, the log is damaged: delete that line, or delete the run "
-                 "directory and rerun `python3 -m kage.bench run` to train the run again")
-        if not isinstance(row, dict) or "kind" not in row:
-            fail(f"{path}, line {number}: not a kage.ppo.train log row (no \"kind\"): delete that line, or delete the run "
-                 "directory and rerun `python3 -m kage.bench run` to train the run again")
-        if row["kind"] == "eval":
-            if not (is_number(row.get("global_step")) and isinstance(row.get("train"), dict)
-                    and isinstance(row.get("evals"), dict)):
-                fail(f"{path}, line {number}: an evaluation row without global_step, train and evals: delete that "
-                     "line, or delete the run directory and rerun `python3 -m kage.bench run`")
-            rows.append(row)
+        with open_regular(path, LOG_LIMIT) as f:
+            number = 0
+            while True:
+                data = f.readline(MAX_LINE + 1)
+                if not data:
+                    break
+                number += 1
+                if torn is not None:
+                    break
+                line = data.decode("utf-8", errors="replace")
+                if len(data) > MAX_LINE:
+                    fail(f"{path}, line {number}: over {MAX_LINE:,} bytes, not a log row: the log is damaged: {redo}")
+                if not line.strip():
+                    continue
+                try:
+                    row = json.loads(line)
+                except (ValueError, RecursionError):
+                    torn = number
+                    continue
+                if not isinstance(row, dict) or "kind" not in row:
+                    fail(f"{path}, line {number}: not a kage.ppo.train log row (no \"kind\"): delete that line, or "
+                         f"{redo}")
+                if row["kind"] == "eval":
+                    if not (is_number(row.get("global_step")) and isinstance(row.get("train"), dict)
+                            and isinstance(row.get("evals"), dict)):
+                        fail(f"{path}, line {number}: an evaluation row without global_step, train and evals: delete "
+                             f"that line, or {redo}")
+                    rows.append(row)
+    except OSError as e:  # NotRegularFile too: a FIFO or a device (a symlink to /dev/zero), too large
+        fail(f"cannot read {path} ({e.strerror or e}): replace it by the run's log, or {redo}")
+    if torn is not None and torn != number:
+        fail(f"{path}, line {torn}: not a JSON row, the log is damaged: delete that line, or {redo}")
     return rows
 
 
