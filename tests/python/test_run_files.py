@@ -147,3 +147,13 @@ def test_run_refuses_a_seed_range_of_ten_billion(tmp_path):
     refused(done, "--seeds", "more than 1,000,000 seeds", "give fewer seeds")
     assert not (tmp_path / "bench").exists()
 
+
+@pytest.mark.parametrize("command", ["report", "compare"])
+def test_a_trillion_resamples_are_refused(tmp_path, command):
+    """--reps 10**12 kept every resample's statistic until the memory ran out (a MemoryError at 3 GiB); 0 or -5
+    ended in a ValueError traceback from kage.bench.stats."""
+    bench = one_pair(tmp_path / "A")
+    dirs = [str(bench), str(one_pair(tmp_path / "B"))] if command == "compare" else [str(bench)]
+    for reps in ("1000000000000", "0", "-5"):
+        refused(bounded("-m", "kage.bench", command, *dirs, "--reps", reps), f"kage.bench {command}: --reps {reps}",
+                "a number of bootstrap resamples from 1 to 10,000,000")

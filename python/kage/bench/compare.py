@@ -263,6 +263,8 @@ def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optiona
         fail(f"unknown protocol '{protocol}': choose {' or '.join(report.PROTOCOLS)}")
     if metric not in intervals.METRICS:
         fail(f"--metric takes {', '.join(intervals.METRICS)}, not '{metric}'")
+    if intervals.reps_problem(reps):
+        fail(intervals.reps_problem(reps))
     methods = [load(d, name, protocol) for d, name in zip(dirs, method_names(dirs, names))]
     check_comparable(methods)
     restrict(methods, protocol, reps, metric)

@@ -492,6 +492,8 @@ def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
         fail(f"unknown protocol '{protocol}': choose {' or '.join(PROTOCOLS)}")
     if metric not in intervals.METRICS:
         fail(f"the interval estimates take {', '.join(intervals.METRICS)}, not '{metric}'")
+    if intervals.reps_problem(reps):
+        fail(intervals.reps_problem(reps))
     suite, bench, units, runs = read_benchmark(bench_dir)
     out_dir = out_dir or os.path.join(bench_dir, ("report" if protocol == "max" else "report_final")
                                       + ("_interim" if partial else ""))
