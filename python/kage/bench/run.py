@@ -41,7 +41,7 @@ from typing import Dict, List, Optional
 from kage import front_end, resources
 from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
-from kage.bench.records import bench_problem, suite_problem
+from kage.bench.records import MAX_SEED, bench_problem, suite_problem, unit_name_problem
 from kage.bench.units import Unit, select, units_of
 from kage.errors import ConfigError
 from kage.util.files import (LOG_LIMIT, atomic_write, open_regular, os_error_text, read_json_record, read_regular,
@@ -54,7 +54,7 @@ MAX_SEEDS = 1_000_000  # a list of seeds beyond this is a typo (1-10000000000), 
 
 
 def parse_seeds(text: str) -> List[int]:
-    """"1-10", "1,3,5" or "7": at most MAX_SEEDS seeds."""
+    """"1-10", "1,3,5" or "7": at most MAX_SEEDS seeds, each below 2**63 (kage.ppo.train's --seed)."""
     seeds: List[int] = []
     for part in text.split(","):
         m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
@@ -63,6 +63,8 @@ def parse_seeds(text: str) -> List[int]:
         first, last = int(m[1]), int(m[2] or m[1])
         if last < first:
             raise SystemExit(f"kage.bench: --seeds {text!r}: the range {first}-{last} is empty")
+        if last >= MAX_SEED:
+            raise SystemExit(f"kage.bench: --seeds {text!r}: seed {last} is too large: seeds are below 2**63")
         if len(seeds) + last - first + 1 > MAX_SEEDS:
             raise SystemExit(f"kage.bench: --seeds {text!r:.80}: more than {MAX_SEEDS:,} seeds, a run each per pair: "
                              "give fewer seeds")
@@ -85,11 +87,9 @@ def units_to_train(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
 
 
 def check_unit_name(name: str) -> None:
-    """Refuses a pair or sweep name that would not be a folder inside DIR/runs/ (absolute, "..", ".", an empty
-    part, a backslash or a control character), since its runs are written under DIR/runs/<name>/."""
-    parts = name.split("/")
-    if not name or name.startswith("/") or "\\" in name or any(p in ("", ".", "..") for p in parts) or \
-            any(ord(c) < 32 or ord(c) == 127 for c in name):
+    """Refuses a pair or sweep name that would not be a folder inside DIR/runs/ (records.unit_name_problem), since
+    its runs are written under DIR/runs/<name>/."""
+    if unit_name_problem(name):
         raise SystemExit(f"kage.bench: pair or sweep name {name!r}: its runs go to DIR/runs/<name>/, so the name must "
                          "be a relative path of plain parts (no leading '/', no '.' or '..' parts, no empty part, no "
                          "backslash or control character): rename it in the suite")
