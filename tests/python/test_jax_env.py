@@ -219,3 +219,43 @@ def test_import_without_jax_says_how_to_get_it():
             "try:\n    import kage.jax\nexcept ImportError as e:\n    print(e)\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=dict(os.environ))
     assert "kage.jax needs JAX: `pip install jax`" in done.stdout, done.stdout + done.stderr
+
+
+# ---- make_vec's limits, and messages that name the argument (issue 37) ----
+
+def refusal_text(call):
+    """The text of the ValueError `call` raises, from its "cannot build" on (each caller names itself before)."""
+    with pytest.raises(ValueError) as error:
+        call()
+    text = str(error.value)
+    return text[text.index("cannot build"):] if "cannot build" in text else text
+
+
+def test_make_env_refuses_what_make_vec_refuses():
+    """2**40 environments were accepted (and reset derived their seeds in a Python loop, to gigabytes); every
+    count that make_vec refuses, by its int32 limit or by memory, make_env refuses in make_vec's words."""
+    frame = int(np.prod(kage.make_vec(SIMPLEST, 1, threads=1).single_observation_space.shape))
+    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    for n in (2**40, 2**31, 0, -3):
+        with pytest.raises(ValueError, match=r"num_envs=-?\d+: a positive integer up to 2147483647") as error:
+            kage.make_vec(SIMPLEST, n)
+        with pytest.raises(ValueError) as jax_error:
+            kage.jax.make_env(SIMPLEST, n)
+        assert str(jax_error.value) == str(error.value)
+    # Two frames an environment (its observation and its final one) already pass half of the memory.
+    for n in (2**31 - 1, memory // frame):
+        vec = refusal_text(lambda: kage.make_vec(SIMPLEST, n))
+        assert "more than half of this machine's" in vec, vec
+        with pytest.raises(ValueError, match=rf"^kage.jax.make_env: num_envs={n}: cannot build") as error:
+            kage.jax.make_env(SIMPLEST, n)
+        assert vec in str(error.value)
+    assert kage.jax.make_env(SIMPLEST, 3).num_envs == 3
+
+
+def test_seed_words_of_many_environments_are_make_vecs():
+    """The output constants of 2 N words come from one numpy pass, not a Python loop of 2 N steps."""
+    from kage.jax.seeds import _output_constants, env_seed_words
+    _output_constants.cache_clear()
+    words = env_seed_words(jnp.uint32(12), 200_000)
+    assert_same(np.asarray(words).view("<u8").ravel(), kage.env_seeds(12, 200_000), "seeds of 200,000 environments")
+

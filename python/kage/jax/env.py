@@ -210,9 +210,12 @@ def make_env(config: Union[str, os.PathLike], num_envs: int, asset_root=None) ->
 
     Raises what ``kage.make_vec`` raises for the same config: ``kage.ConfigError`` with kagec's located
     diagnostics, ``FileNotFoundError``, ``ValueError`` for bad arguments. ``asset_root`` as make_vec's.
+    ``num_envs`` has make_vec's limits: at most 2**31 - 1, and no more environments than make_vec builds on
+    the CPU (their states, observations and render scratch within half of the machine's memory), on every
+    backend; beyond them it raises ValueError with make_vec's words before anything is allocated.
     """
-    if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs <= 0:
-        raise ValueError(f"num_envs={num_envs!r}: a positive integer")
+    if not vector._is_integer(num_envs) or not 0 < num_envs <= vector.MAX_INT32:
+        raise ValueError(f"num_envs={num_envs!r}: a positive integer up to {vector.MAX_INT32}")
     # One CPU environment of make_vec: its errors, its resolved path and the dtypes of its outputs.
     probe = vector.make_vec(config, 1, device="cpu", threads=1, asset_root=asset_root)
     try:
@@ -228,4 +231,7 @@ def make_env(config: Union[str, os.PathLike], num_envs: int, asset_root=None) ->
     if sizes["spec_hash"] != spec_hash:
         raise RuntimeError(f"kage.jax: {path} has spec hash {sizes['spec_hash']} here but {spec_hash} in make_vec: "
                            "kage._kage and kage._kage_jax come from different builds; reinstall")
+    refusal = _native.module().memory_refusal(spec_hash, int(num_envs))
+    if refusal:
+        raise ValueError(f"kage.jax.make_env: num_envs={int(num_envs)}: {refusal}")
     return JaxEnv(path, int(num_envs), sizes, dtypes)
