@@ -259,3 +259,33 @@ def test_seed_words_of_many_environments_are_make_vecs():
     words = env_seed_words(jnp.uint32(12), 200_000)
     assert_same(np.asarray(words).view("<u8").ravel(), kage.env_seeds(12, 200_000), "seeds of 200,000 environments")
 
+
+@pytest.mark.parametrize("actions, error, said", [
+    ("01", TypeError, r"^actions='01': a str, expected int32 \[2\], one action in 0..7 per environment"),
+    ([2**31, 0], ValueError, r"^actions: 2147483648 does not fit int32 \(and actions are 0..7\)"),
+    ([2**64, 0], ValueError, rf"^actions: {2**64} does not fit int32"),
+    (b"\x01\x02", TypeError, r"^actions=b'\\x01\\x02': a bytes, expected int32"),
+    ([None, 1], TypeError, r"^actions: object values \(\[None, 1\]\), expected int32 \[2\]"),
+    ([[1, 2]], ValueError, r"^actions: shape \(1, 2\), expected \(2,\)"),
+], ids=["string", "beyond-int32", "beyond-int64", "bytes", "none", "nested"])
+def test_actions_that_are_not_int32_name_the_argument(actions, error, said):
+    env = kage.jax.make_env(SIMPLEST, 2)
+    state, _, _ = env.reset(0)
+    with pytest.raises(error, match=said):
+        env.step(state, actions)
+    state, *_ = env.step(state, [1, 6])  # a list of small ints is still taken, as int32
+    env.check(state)
+
+
+def test_check_inside_jit_says_to_call_it_outside():
+    env = kage.jax.make_env(SIMPLEST, 2)
+    state, _, _ = env.reset(0)
+    outside = "reads the state's action record back from the device, so it runs outside jax.jit, vmap and scan"
+    with pytest.raises(TypeError, match=outside):
+        jax.jit(env.check)(state)
+    batched = jax.vmap(env.reset)(jnp.asarray([1, 2], jnp.uint32))[0]
+    with pytest.raises(TypeError, match=outside):
+        jax.vmap(env.check)(batched)
+    with pytest.raises(TypeError, match=outside):
+        jax.lax.scan(lambda s, _: (s, env.check(s)), state, None, length=1)
+    env.check(batched)  # outside: a batched state is checked whole

@@ -130,8 +130,12 @@ class JaxEnv:
     def check(self, state: KageState) -> None:
         """Raises ValueError if any step since the reset had an action outside 0..7 (naming the first);
         call it outside ``jit`` (it reads the [N, 2] record from the device), e.g. after a scan. A state with
-        leading vmap axes is checked whole."""
+        leading vmap axes is checked whole. Inside ``jit``, ``vmap`` or ``scan`` it raises TypeError saying so."""
         self._check_state(state, batched=True)
+        if isinstance(state.action_error, jax.core.Tracer):
+            raise TypeError("env.check(state) reads the state's action record back from the device, so it runs outside "
+                            "jax.jit, vmap and scan: call it on the state that your jitted function returns (after the "
+                            "scan, say), not inside it")
         record = np.asarray(jax.device_get(state.action_error))
         hits = np.argwhere(record[..., 1] != 0)
         if hits.size == 0:
@@ -190,7 +194,7 @@ class JaxEnv:
     def _check_actions(self, actions):
         shape, dtype = getattr(actions, "shape", None), getattr(actions, "dtype", None)
         if shape is None or dtype is None:
-            actions = jnp.asarray(actions)
+            actions = _host_actions(actions, self.num_envs)
             shape, dtype = actions.shape, actions.dtype
         if tuple(shape) != (self.num_envs,):
             raise ValueError(f"actions: shape {tuple(shape)}, expected ({self.num_envs},): one action per environment")
@@ -203,6 +207,27 @@ class JaxEnv:
         out = dict(info)
         out.update(zip(_FINAL_KEYS, (state.final_obs, state.final_info, final_mask, final_mask, final_mask)))
         return out
+
+
+def _host_actions(actions, num_envs: int):
+    """Actions given as a Python sequence (a list of ints): an int32 array, or TypeError / ValueError naming
+    ``actions`` where they are not integers that int32 holds. Strings are refused, not parsed."""
+    expected = f"expected int32 [{num_envs}], one action in 0..7 per environment"
+    if isinstance(actions, (str, bytes)):
+        raise TypeError(f"actions={actions!r:.40}: a {type(actions).__name__}, {expected}")
+    try:
+        values = np.asarray(actions)
+    except (TypeError, ValueError, OverflowError) as e:
+        raise TypeError(f"actions: a {type(actions).__name__} that is not an array of integers ({e}); {expected}") \
+            from None
+    integers = values.dtype.kind in "iu" or (values.dtype.kind == "O" and all(  # "O": ints beyond 64 bits
+        isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values.reshape(-1).tolist()))
+    if not integers:
+        raise TypeError(f"actions: {values.dtype} values ({str(actions)[:40]}), {expected}")
+    big = [int(v) for v in values.reshape(-1).tolist() if not -2**31 <= int(v) < 2**31]
+    if big:
+        raise ValueError(f"actions: {big[0]} does not fit int32 (and actions are 0..7); {expected}")
+    return jnp.asarray(values.astype(np.int32))
 
 
 def make_env(config: Union[str, os.PathLike], num_envs: int, asset_root=None) -> JaxEnv:
