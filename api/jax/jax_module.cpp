@@ -3,6 +3,10 @@
 // jax.ffi and calls them with jax.ffi.ffi_call.
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
+#include <thread>
+
+#include "api/environment.h"
 #include "api/jax/ffi_handlers.h"
 #include "api/jax/jax_config.h"
 #include "api/python/paths.h"
@@ -46,6 +50,20 @@ py::dict register_config(const std::string& path, const std::string& asset_root)
   return d;
 }
 
+/// Why `num_envs` environments of a registered config do not fit: kage::memory_refusal, make_vec's limit for a
+/// CPU batch (more than half of the machine's memory), with the CPU handlers' threads (one per core, at most one
+/// per environment); empty when they fit.
+std::string memory_refusal(const std::string& spec_hash, int64_t num_envs) {
+  const std::shared_ptr<const kage::jax::JaxConfig> c = kage::jax::find_config(spec_hash);
+  if (!c) throw std::runtime_error("kage.jax: no config with spec hash " + spec_hash + " is registered");
+  kage::LoweredConfig config;
+  config.latent = c->latent;
+  config.visual = c->visual;
+  const int64_t threads =
+      std::max<int64_t>(1, std::min<int64_t>(num_envs, std::max(1u, std::thread::hardware_concurrency())));
+  return kage::memory_refusal(config, num_envs, threads);
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_kage_jax, m) {
@@ -53,6 +71,8 @@ PYBIND11_MODULE(_kage_jax, m) {
   kage::python::register_paths(m);
   m.def("register_config", &register_config, py::arg("path"), py::arg("asset_root"),
         "Loads a config for the FFI handlers, keyed by its Spec hash; returns its sizes.");
+  m.def("memory_refusal", &memory_refusal, py::arg("spec_hash"), py::arg("num_envs"),
+        "Why num_envs environments of a registered config exceed make_vec's memory limit; '' when they fit.");
   m.def("targets", [] {
     // platform -> {target name -> {stage -> capsule}}, as jax.ffi.register_ffi_target takes them.
     py::dict platforms, cpu;

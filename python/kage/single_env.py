@@ -15,14 +15,17 @@ from typing import Any, Dict, Optional, Tuple
 import gymnasium
 import numpy as np
 
+from kage.registration import ENV_ID, missing_config
 from kage.vector import make_vec
 
 
 class SingleEnv(gymnasium.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 60}  # a step is dt = 1/60 s of game time (spec)
 
-    def __init__(self, config: str, device: str = "cpu", render_mode: Optional[str] = "rgb_array",
+    def __init__(self, config: Optional[str] = None, device: str = "cpu", render_mode: Optional[str] = "rgb_array",
                  asset_root: Optional[str] = None):
+        if config is None:
+            raise missing_config(f"gymnasium.make({ENV_ID!r}, config='throughput/simplest')")
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode={render_mode!r}: KAGE renders 'rgb_array' frames only")
         self.render_mode = render_mode

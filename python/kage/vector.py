@@ -308,6 +308,9 @@ def make_vec(config: Union[str, os.PathLike], num_envs: int, device: str = "cpu"
     machine's memory. The batch holds no episode until the first ``reset()`` (or ``load_state``): a step
     before it raises ``RuntimeError``.
     """
+    if not isinstance(config, (str, bytes, os.PathLike)):
+        raise TypeError(f"config={config!r:.80}: a path (str or os.PathLike) to a YAML config or a kagec compile "
+                        "directory, or a shipped config's name")
     config = os.fspath(config)
     if device not in ("cpu", "cuda"):
         raise ValueError(f"device={device!r}: use 'cpu' or 'cuda'")

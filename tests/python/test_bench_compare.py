@@ -136,16 +136,48 @@ def test_compares_the_results_every_method_has(two):
 
 
 def test_refuses_directories_with_no_result_in_common(two):
+    """B finished only layout/1, whose runs A has not finished."""
     a, b = two
     bench = json.loads((b / "bench.json").read_text())
     (b / "bench.json").write_text(json.dumps({**bench, "units": ["layout/1"]}))
     for name in ("background/1", "background/2"):
         shutil.rmtree(b / "runs" / name)
     for seed in (1, 2, 3):
-        (b / "runs" / "layout/1" / f"seed_{seed}" / "summary.json").unlink()
-    with pytest.raises(SystemExit, match=r"no \(pair, seed\) result is finished in every directory \(finished: A 9, B "
-                                         r"0\): run the same pairs and seeds"):
+        (a / "runs" / "layout/1" / f"seed_{seed}" / "summary.json").unlink()
+    with pytest.raises(SystemExit, match=r"no \(pair, seed\) result is finished in every directory \(finished: A 6, B "
+                                         r"3\): run the same pairs and seeds"):
         compare.compare([str(a), str(b)], reps=100)
+
+
+def test_a_directory_without_finished_runs_is_named(two, tmp_path):
+    """B with no run at all, or with runs that have not finished: the message says so (it said "another protocol
+    (total_timesteps 2048 and None ...)" for the first), in compare's name."""
+    a, b = two
+    empty = tmp_path / "empty"
+    write_suite(empty, PAIRS)
+    with pytest.raises(SystemExit, match=r"^kage.bench compare: .*empty has no finished run \(a run directory with "
+                                         r"summary.json\): compare reads finished runs only: let them finish "
+                                         r"\(kage.bench status .*empty\)"):
+        compare.compare([str(a), str(empty)], reps=100)
+    for summary in b.glob("runs/*/*/seed_*/summary.json"):
+        summary.unlink()
+    with pytest.raises(SystemExit, match=r"B has no finished run .*; its 9 runs are still training or stopped"):
+        compare.compare([str(a), str(b)], reps=100)
+
+
+def test_runs_without_run_json_are_named(two):
+    a, b = two
+    for run_json in b.glob("runs/*/*/seed_*/run.json"):
+        run_json.unlink()
+    with pytest.raises(SystemExit, match=r"the runs of .*B have no run.json with their arguments, so their protocol "
+                                         r"cannot be compared"):
+        compare.compare([str(a), str(b)], reps=100)
+
+
+def test_a_directory_that_is_not_one_is_refused_in_compares_name(two, tmp_path):
+    a, _ = two
+    with pytest.raises(SystemExit, match=r"^kage.bench compare: .*absent is not a directory: give the --out"):
+        compare.compare([str(a), str(tmp_path / "absent")], reps=100)
 
 
 def test_refuses_another_protocol(two, tmp_path):

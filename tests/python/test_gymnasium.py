@@ -82,3 +82,26 @@ def test_the_single_environment_ends_an_episode_as_gymnasium_says():
             env.step(8)
     finally:
         env.close()
+
+
+def test_a_make_without_config_or_with_a_bad_one_names_the_fix():
+    """It raised Python's "missing 1 required positional argument: 'config'", "expected str, bytes or
+    os.PathLike object, not int", or make_vec's "unexpected keyword argument 'render_mode'"."""
+    with pytest.raises(TypeError, match=r"kage/KAGE-v0: config= names the game: .*e\.g\. "
+                                        r"gymnasium\.make\('kage/KAGE-v0', config='throughput/simplest'\)"):
+        gymnasium.make("kage/KAGE-v0")
+    with pytest.raises(TypeError, match=r"config= names the game: .*e\.g\. gymnasium\.make_vec\('kage/KAGE-v0', "
+                                        r"num_envs=2, vectorization_mode='vector_entry_point', config="):
+        gymnasium.make_vec("kage/KAGE-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    with pytest.raises(TypeError, match=r"config=5: a path \(str or os\.PathLike\) to a YAML config"):
+        gymnasium.make("kage/KAGE-v0", config=5)
+    with pytest.raises(TypeError, match=r"config=\['a.yaml'\]: a path"):
+        kage.make_vec(["a.yaml"], 2)
+    with pytest.raises(ValueError, match=r"render_mode='rgb_array': kage/KAGE-v0's vector environment renders no "
+                                         r"frames of its own"):
+        gymnasium.make_vec("kage/KAGE-v0", num_envs=2, vectorization_mode="vector_entry_point", config=SIMPLEST,
+                           render_mode="rgb_array")
+    env = gymnasium.make_vec("kage/KAGE-v0", num_envs=2, vectorization_mode="vector_entry_point", config=SIMPLEST,
+                             render_mode=None)
+    assert env.reset(seed=1)[0].shape[0] == 2
+    env.close()

@@ -219,3 +219,73 @@ def test_import_without_jax_says_how_to_get_it():
             "try:\n    import kage.jax\nexcept ImportError as e:\n    print(e)\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=dict(os.environ))
     assert "kage.jax needs JAX: `pip install jax`" in done.stdout, done.stdout + done.stderr
+
+
+# ---- make_vec's limits, and messages that name the argument (issue 37) ----
+
+def refusal_text(call):
+    """The text of the ValueError `call` raises, from its "cannot build" on (each caller names itself before)."""
+    with pytest.raises(ValueError) as error:
+        call()
+    text = str(error.value)
+    return text[text.index("cannot build"):] if "cannot build" in text else text
+
+
+def test_make_env_refuses_what_make_vec_refuses():
+    """2**40 environments were accepted (and reset derived their seeds in a Python loop, to gigabytes); every
+    count that make_vec refuses, by its int32 limit or by memory, make_env refuses in make_vec's words."""
+    frame = int(np.prod(kage.make_vec(SIMPLEST, 1, threads=1).single_observation_space.shape))
+    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    for n in (2**40, 2**31, 0, -3):
+        with pytest.raises(ValueError, match=r"num_envs=-?\d+: a positive integer up to 2147483647") as error:
+            kage.make_vec(SIMPLEST, n)
+        with pytest.raises(ValueError) as jax_error:
+            kage.jax.make_env(SIMPLEST, n)
+        assert str(jax_error.value) == str(error.value)
+    # Two frames an environment (its observation and its final one) already pass half of the memory.
+    for n in (2**31 - 1, memory // frame):
+        vec = refusal_text(lambda: kage.make_vec(SIMPLEST, n))
+        assert "more than half of this machine's" in vec, vec
+        with pytest.raises(ValueError, match=rf"^kage.jax.make_env: num_envs={n}: cannot build") as error:
+            kage.jax.make_env(SIMPLEST, n)
+        assert vec in str(error.value)
+    assert kage.jax.make_env(SIMPLEST, 3).num_envs == 3
+
+
+def test_seed_words_of_many_environments_are_make_vecs():
+    """The output constants of 2 N words come from one numpy pass, not a Python loop of 2 N steps."""
+    from kage.jax.seeds import _output_constants, env_seed_words
+    _output_constants.cache_clear()
+    words = env_seed_words(jnp.uint32(12), 200_000)
+    assert_same(np.asarray(words).view("<u8").ravel(), kage.env_seeds(12, 200_000), "seeds of 200,000 environments")
+
+
+@pytest.mark.parametrize("actions, error, said", [
+    ("01", TypeError, r"^actions='01': a str, expected int32 \[2\], one action in 0..7 per environment"),
+    ([2**31, 0], ValueError, r"^actions: 2147483648 does not fit int32 \(and actions are 0..7\)"),
+    ([2**64, 0], ValueError, rf"^actions: {2**64} does not fit int32"),
+    (b"\x01\x02", TypeError, r"^actions=b'\\x01\\x02': a bytes, expected int32"),
+    ([None, 1], TypeError, r"^actions: object values \(\[None, 1\]\), expected int32 \[2\]"),
+    ([[1, 2]], ValueError, r"^actions: shape \(1, 2\), expected \(2,\)"),
+], ids=["string", "beyond-int32", "beyond-int64", "bytes", "none", "nested"])
+def test_actions_that_are_not_int32_name_the_argument(actions, error, said):
+    env = kage.jax.make_env(SIMPLEST, 2)
+    state, _, _ = env.reset(0)
+    with pytest.raises(error, match=said):
+        env.step(state, actions)
+    state, *_ = env.step(state, [1, 6])  # a list of small ints is still taken, as int32
+    env.check(state)
+
+
+def test_check_inside_jit_says_to_call_it_outside():
+    env = kage.jax.make_env(SIMPLEST, 2)
+    state, _, _ = env.reset(0)
+    outside = "reads the state's action record back from the device, so it runs outside jax.jit, vmap and scan"
+    with pytest.raises(TypeError, match=outside):
+        jax.jit(env.check)(state)
+    batched = jax.vmap(env.reset)(jnp.asarray([1, 2], jnp.uint32))[0]
+    with pytest.raises(TypeError, match=outside):
+        jax.vmap(env.check)(batched)
+    with pytest.raises(TypeError, match=outside):
+        jax.lax.scan(lambda s, _: (s, env.check(s)), state, None, length=1)
+    env.check(batched)  # outside: a batched state is checked whole

@@ -73,7 +73,13 @@ def schedule_of(run: report.Run) -> dict:
 
 
 def load(bench_dir: str, name: str, protocol: str) -> Method:
-    suite, bench, units, runs = report.read_benchmark(bench_dir)
+    try:
+        suite, bench, units, runs = report.read_benchmark(bench_dir)
+    except SystemExit as e:  # the report's refusal of a directory or a record, in compare's name
+        prefix = "kage.bench report: "
+        if str(e).startswith(prefix):
+            fail(str(e)[len(prefix):])
+        raise
     every_run = [r for unit_runs in runs.values() for r in unit_runs]
     schedules = {json.dumps(schedule_of(r), sort_keys=True) for r in every_run if r.args}
     if len(schedules) > 1:
@@ -83,6 +89,12 @@ def load(bench_dir: str, name: str, protocol: str) -> Method:
     levels = report.aggregate(units, runs, protocol)
     if not levels["pairs"]:
         fail(f"{bench_dir} has no plain pair (only sweeps): compare reads plain pairs")
+    if not levels["runs"]:
+        unfinished = len(every_run)
+        fail(f"{bench_dir} has no finished run (a run directory with summary.json)"
+             + (f"; its {unfinished} runs are still training or stopped" if unfinished else "") +
+             f": compare reads finished runs only: let them finish (kage.bench status {bench_dir}), or compare "
+             "other directories")
     return Method(name, bench_dir, suite, sorted(seeds), json.loads(schedules.pop()) if schedules else {}, units,
                   runs, {(r["pair"], r["seed"]) for r in levels["runs"]})
 
@@ -113,6 +125,10 @@ def check_comparable(methods: List[Method]) -> None:
             fail(f"{pair} are not of the same suite: {'; '.join(differences[:3])}: compare runs of one suite")
         if first.seeds != other.seeds:
             fail(f"{pair} have other seeds ({first.seeds} and {other.seeds}): run both with the same --seeds")
+        unrecorded = [m.bench_dir for m in (first, other) if not m.schedule]
+        if len(unrecorded) == 1:
+            fail(f"the runs of {unrecorded[0]} have no run.json with their arguments, so their protocol cannot be "
+                 "compared with the other directory's: restore their run.json files, or compare other directories")
         keys = [k for k in SCHEDULE_ARGS if first.schedule.get(k) != other.schedule.get(k)]
         if keys:
             shown = ", ".join(f"{k} {first.schedule.get(k)} and {other.schedule.get(k)}" for k in keys)
@@ -247,6 +263,8 @@ def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optiona
         fail(f"unknown protocol '{protocol}': choose {' or '.join(report.PROTOCOLS)}")
     if metric not in intervals.METRICS:
         fail(f"--metric takes {', '.join(intervals.METRICS)}, not '{metric}'")
+    if intervals.reps_problem(reps):
+        fail(intervals.reps_problem(reps))
     methods = [load(d, name, protocol) for d, name in zip(dirs, method_names(dirs, names))]
     check_comparable(methods)
     restrict(methods, protocol, reps, metric)

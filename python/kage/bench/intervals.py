@@ -27,6 +27,7 @@ from kage.util.tables import SUCCESS_SHOWN
 
 CONFIDENCE = 0.95
 REPS = 50000
+MAX_REPS = 10_000_000  # beyond it the bounds move in the fourth digit only, and the time grows without end
 SEED = 0
 TAUS = np.arange(101) / 100  # 0, 0.01, ..., 1: each the double nearest its decimal
 ALL_PAIRS = "all pairs"
@@ -82,6 +83,13 @@ def profile(scores: Scores, reps: int) -> Optional[dict]:
         p = stats.performance_profile(matrix, TAUS, reps, CONFIDENCE, SEED, scores.groups)
         curves[side] = {"point": p.point.tolist(), "low": p.low.tolist(), "high": p.high.tolist()}
     return {"taus": TAUS.tolist(), **curves}
+
+
+def reps_problem(reps) -> Optional[str]:
+    """Why `reps` (--reps of report and compare) is not a number of bootstrap resamples to draw, or None."""
+    if isinstance(reps, bool) or not isinstance(reps, int) or not 1 <= reps <= MAX_REPS:
+        return f"--reps {reps}: a number of bootstrap resamples from 1 to {MAX_REPS:,} (default {REPS:,})"
+    return None
 
 
 def interval_report(level1: List[dict], pairs: List[dict], reps: int = REPS, metric: str = SUCCESS_SHOWN) -> dict:

@@ -1,36 +1,124 @@
 """What the JSON records of a benchmark folder must hold to be read: bench.json (the units, seeds and trainer
 flags, written by kage.bench run) and suite.json (each pair's name and spec hashes). One answer for every
-reader (run, status, report), each of which refuses a damaged record in its own words."""
+reader (run, status, report, compare), each of which refuses a damaged record in its own words.
+
+A unit's runs are folders DIR/runs/<unit>/seed_<s>/, so a unit name must stay inside DIR/runs/ (unit_name_problem)
+and a seed be one that kage.ppo.train takes (0 <= s < 2**63)."""
 from typing import Optional, Sequence
 
-
-def _strings(value) -> bool:
-    return isinstance(value, list) and all(isinstance(v, str) for v in value)
+MAX_SEED = 2**63  # kage.ppo.train's --seed is below it
 
 
-def _integers(value) -> bool:
-    return isinstance(value, list) and all(isinstance(v, int) and not isinstance(v, bool) for v in value)
+def unit_name_problem(name) -> Optional[str]:
+    """Why `name` cannot be a folder inside DIR/runs/ (absolute, a "." or ".." part, an empty part, a backslash
+    or a control character), or None."""
+    if not isinstance(name, str):
+        return f"{name!r:.60} is not a string"
+    if not name or name.startswith("/") or "\\" in name or any(p in ("", ".", "..") for p in name.split("/")) or \
+            any(ord(c) < 32 or ord(c) == 127 for c in name):
+        return (f"{name!r:.60} is not a relative path of plain parts (no leading '/', no '.' or '..' parts, no empty "
+                "part, no backslash or control character)")
+    return None
 
 
-BENCH_KEYS = {"units": _strings, "seeds": _integers, "trainer_args": _strings}
+def _strings(value) -> Optional[str]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        return "not a list of strings"
+    return None
+
+
+def _units(value) -> Optional[str]:
+    if not isinstance(value, list):
+        return "not a list of unit names"
+    for name in value:
+        problem = unit_name_problem(name)
+        if problem:
+            return problem
+    if len(set(value)) < len(value):
+        return f"{sorted(v for v in set(value) if value.count(v) > 1)[0]!r:.60} is listed twice"
+    return None
+
+
+def _seeds(value) -> Optional[str]:
+    if not isinstance(value, list) or not all(isinstance(v, int) and not isinstance(v, bool) for v in value):
+        return "not a list of integers"
+    bad = [v for v in value if not 0 <= v < MAX_SEED]
+    if bad:
+        return f"seed {str(bad[0])[:60]} is outside [0, 2**63), the seeds kage.ppo.train takes"
+    if len(set(value)) < len(value):
+        return f"seed {next(v for v in value if value.count(v) > 1)} is listed twice"
+    return None
+
+
+def _shared(value) -> Optional[str]:
+    """--share-training's {pair: [unit, label]}."""
+    if not isinstance(value, dict):
+        return "not an object {pair: [unit, label]}"
+    for pair, where in value.items():
+        if not (isinstance(where, list) and len(where) == 2 and all(isinstance(v, str) for v in where)):
+            return f"the entry of {pair!r:.60} is not [unit, label]"
+        problem = unit_name_problem(where[0])
+        if problem:
+            return problem
+    return None
+
+
+BENCH_KEYS = {"units": _units, "seeds": _seeds, "trainer_args": _strings}
+OPTIONAL_KEYS = {"shared": _shared}  # checked where present
 
 
 def bench_problem(bench, keys: Sequence[str] = tuple(BENCH_KEYS)) -> Optional[str]:
-    """What bench.json's content lacks of `keys` (its units, seeds and trainer flags), or None."""
+    """What bench.json's content lacks of `keys` (its units, seeds and trainer flags), or where one is not what
+    kage.bench run writes (a seed it would not train, a unit name outside DIR/runs/, an entry twice); None when
+    it holds them. "shared" is checked where present."""
     if not isinstance(bench, dict):
         return f"a JSON {type(bench).__name__}, not an object"
     for key in keys:
-        if not BENCH_KEYS[key](bench.get(key)):
-            return f"no valid '{key}'"
+        if key not in bench:
+            return f"no '{key}'"
+        problem = BENCH_KEYS[key](bench[key])
+        if problem:
+            return f"no valid '{key}': {problem}"
+    for key, check in OPTIONAL_KEYS.items():
+        problem = check(bench[key]) if key in bench else None
+        if problem:
+            return f"no valid '{key}': {problem}"
+    return None
+
+
+def _side_problem(side) -> Optional[str]:
+    if not (isinstance(side, dict) and isinstance(side.get("spec_sha256"), str) and isinstance(side.get("name"), str)):
+        return "without its name and spec_sha256"
     return None
 
 
 def suite_problem(suite) -> Optional[str]:
-    """What suite.json's content lacks: each pair's name and its two sides' spec hashes, or None."""
+    """What suite.json's content lacks: each pair's name (a unit name, once), its sweep and sweep eval name,
+    declared axis and its two sides' names and spec hashes; None when it holds them."""
+    detail = _suite_detail(suite)
+    return f"not a suite report with each pair's name and spec hashes ({detail})" if detail else None
+
+
+def _suite_detail(suite) -> Optional[str]:
     pairs = suite.get("pairs") if isinstance(suite, dict) else None
-    if not isinstance(pairs, list) or not all(
-            isinstance(p, dict) and isinstance(p.get("pair"), str) and
-            all(isinstance(p.get(side), dict) and isinstance(p[side].get("spec_sha256"), str)
-                for side in ("train", "eval")) for p in pairs):
-        return "not a suite report with each pair's name and spec hashes"
+    if not isinstance(pairs, list):
+        return "no list of pairs"
+    seen = set()
+    for index, p in enumerate(pairs):
+        if not isinstance(p, dict):
+            return f"pair {index} is a JSON {type(p).__name__}, not an object"
+        name = p.get("pair")
+        problem = unit_name_problem(name) or (f"{name!r} is listed twice" if name in seen else None)
+        if problem:
+            return f"pair {index}: {problem}"
+        seen.add(name)
+        sweep, sweep_eval, axis = p.get("sweep"), p.get("sweep_eval"), p.get("declared_axis")
+        if sweep is not None and (unit_name_problem(sweep) or not isinstance(sweep_eval, str)):
+            return f"pair {name!r}: a sweep without a valid sweep name and sweep_eval"
+        if axis is not None and not isinstance(axis, str):
+            return f"pair {name!r}: declared_axis is not a string or null"
+        for side in ("train", "eval"):
+            problem = _side_problem(p.get(side))
+            if problem:
+                return f"pair {name!r}: its {side} config is {problem}"
     return None

@@ -68,10 +68,10 @@ from dataclasses import dataclass, field
 from typing import Dict, List, NoReturn, Optional, Sequence, Set, Tuple
 
 from kage.bench import intervals, plots
-from kage.bench.records import bench_problem
+from kage.bench.records import bench_problem, suite_problem
 from kage.bench.units import Unit, units_of
 from kage.bench.tables import METRICS, PROTOCOL_TEXTS, SUCCESS_SHOWN, write_tables
-from kage.util.files import atomic_write, output_folder, safe
+from kage.util.files import LOG_LIMIT, RECORD_LIMIT, atomic_write, open_regular, output_folder, read_regular, safe
 
 DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # as kage.ppo.train logs
 PROTOCOLS = ("max", "final")
@@ -96,12 +96,14 @@ class Run:
 
 
 def read_json(path: str, remedy: str):
+    """A JSON record of at most RECORD_LIMIT bytes in a regular file, or one line naming `path` and `remedy`."""
     try:
-        with open(path, encoding="utf-8") as f:
-            return json.load(f)
+        return json.loads(read_regular(path, RECORD_LIMIT))
     except FileNotFoundError:
         fail(f"{path} not found: {remedy}")
-    except (OSError, ValueError) as e:
+    except OSError as e:  # NotRegularFile too: a FIFO, a device (a symlink to /dev/zero), too large
+        fail(f"{path}: {e.strerror or e}: {remedy}")
+    except (ValueError, RecursionError) as e:
         fail(f"{path} is not readable JSON ({e}): {remedy}")
 
 
@@ -120,6 +122,9 @@ def load_suite(bench_dir: str) -> dict:
                     for p in suite["pairs"])):
         fail(f"{path} is not a suite report of kagec (\"kagec_suite_report\": 1 with pairs {', '.join(pair_keys)}): "
              f"{rerun}")
+    problem = suite_problem(suite)
+    if problem:
+        fail(f"{path} is damaged: {problem}: {rerun}")
     return suite
 
 
@@ -140,13 +145,17 @@ def find_runs(bench_dir: str, unit: Unit) -> List[Run]:
     unit_dir = os.path.join(bench_dir, "runs", unit.name)
     if not os.path.isdir(unit_dir):
         return []
-    runs = []
-    for entry in os.listdir(unit_dir):
+    runs: Dict[int, Run] = {}
+    for entry in sorted(os.listdir(unit_dir)):
         match = re.fullmatch(r"seed_(\d+)", entry)
         path = os.path.join(unit_dir, entry)
         if match and os.path.isdir(path):
-            runs.append(read_run(int(match[1]), path))
-    return sorted(runs, key=lambda r: r.seed)
+            seed = int(match[1])
+            if seed in runs:  # seed_1 and seed_01: one seed's results twice would count twice
+                fail(f"{runs[seed].path} and {path} are both seed {seed} of {unit.name}: remove the one that "
+                     f"kage.bench run did not write (it names its runs seed_{seed})")
+            runs[seed] = read_run(seed, path)
+    return [runs[seed] for seed in sorted(runs)]
 
 
 def read_run(seed: int, path: str) -> Run:
@@ -155,9 +164,12 @@ def read_run(seed: int, path: str) -> Run:
     run_json = os.path.join(path, "run.json")
     stats = read_summary(summary) if os.path.exists(summary) else None
     evaluations = read_evaluations(metrics) if os.path.exists(metrics) else []
-    args = read_json(run_json, "delete the run directory and rerun `python3 -m kage.bench run` to train it again") \
-        if os.path.exists(run_json) else {}
-    return Run(seed, path, stats, evaluations, args.get("args", {}) if isinstance(args, dict) else {})
+    remedy = "delete the run directory and rerun `python3 -m kage.bench run` to train it again"
+    record = read_json(run_json, remedy) if os.path.exists(run_json) else {"args": {}}
+    args = record.get("args") if isinstance(record, dict) else None
+    if not isinstance(args, dict):
+        fail(f"{run_json} is not a kage.ppo.train run record ({{\"args\": {{...}}}}): {remedy}")
+    return Run(seed, path, stats, evaluations, args)
 
 
 def is_number(value) -> bool:
@@ -177,34 +189,87 @@ def read_summary(path: str) -> dict:
     return stats
 
 
+MAX_LINE = 64 << 20  # bytes of one log row: a real one is a few KB
+
+
+def _value_problem(side) -> Optional[str]:
+    """Why an evaluation row's side ({metric: value}) is not one: not an object, or a value that is neither a
+    number nor null (a string, a list, a boolean)."""
+    if not isinstance(side, dict):
+        return f"is {json.dumps(side)[:40]}, not an object of values"
+    for metric, value in side.items():
+        if value is not None and not (isinstance(value, (int, float)) and not isinstance(value, bool)):
+            return f"has {metric} = {json.dumps(value)[:40]}, not a number or null"
+    return None
+
+
+def eval_row_problem(row: dict) -> Optional[str]:
+    """What an evaluation row lacks of what kage.ppo.train writes: a global_step, the train side and each eval
+    side (and the differences) as objects of numbers or nulls; None where it has them."""
+    if not (is_number(row.get("global_step")) and isinstance(row.get("train"), dict)
+            and isinstance(row.get("evals"), dict)):
+        return "an evaluation row without global_step, train and evals"
+    parts = [("train", row["train"])] + [(f"evals[{json.dumps(k)}]", v) for k, v in row["evals"].items()]
+    diffs = row.get("diffs", {})
+    if not isinstance(diffs, dict):
+        return f"an evaluation row whose diffs are {json.dumps(diffs)[:40]}, not an object"
+    parts += [(f"diffs[{json.dumps(k)}]", v) for k, v in diffs.items()]
+    for where, side in parts:
+        problem = _value_problem(side)
+        if problem:
+            return f"an evaluation row whose {where} {problem}"
+    return None
+
+
 def read_evaluations(path: str) -> List[dict]:
-    """The evaluation rows of a metrics.jsonl. A last line that does not parse is a row the run was
-    killed while writing, and is skipped; a damaged line before it is an error."""
+    """The evaluation rows of a metrics.jsonl, in the order of their steps. A last line that does not parse is a
+    row the run was killed while writing, and is skipped; a damaged line before it is an error, and so is an
+    evaluation row that is not after the one before it (a duplicated or out-of-order row: the trainer writes each
+    once, in order, and drops on resume what it writes again), which the final protocol would misread. The file
+    must be a regular file of at most LOG_LIMIT bytes."""
+    redo = "delete the run directory and rerun `python3 -m kage.bench run` to train the run again"
+    rows: List[dict] = []
+    torn: Optional[int] = None  # a line that did not parse: an error unless it is the last
+    previous = (0, None)  # the line and step of the last evaluation row
     try:
-        with open(path, "rb") as f:
-            lines = f.read().decode("utf-8", errors="replace").splitlines()
-    except OSError as e:
-        fail(f"cannot read {path} ({e}): make it readable, or delete the run directory and rerun it")
-    rows = []
-    for number, line in enumerate(lines, start=1):
-        if not line.strip():
-            continue
-        try:
-            row = json.loads(line)
-        except ValueError:
-            if number == len(lines):
-                break
-            fail(f"{path}, line {number}: not a JSON row, the log is damaged: delete that line, or delete the run "
-                 "directory and rerun `python3 -m kage.bench run` to train the run again")
-        if not isinstance(row, dict) or "kind" not in row:
-            fail(f"{path}, line {number}: not a kage.ppo.train log row (no \"kind\"): delete that line, or delete the run "
-                 "directory and rerun `python3 -m kage.bench run` to train the run again")
-        if row["kind"] == "eval":
-            if not (is_number(row.get("global_step")) and isinstance(row.get("train"), dict)
-                    and isinstance(row.get("evals"), dict)):
-                fail(f"{path}, line {number}: an evaluation row without global_step, train and evals: delete that "
-                     "line, or delete the run directory and rerun `python3 -m kage.bench run`")
-            rows.append(row)
+        with open_regular(path, LOG_LIMIT) as f:
+            number = 0
+            while True:
+                data = f.readline(MAX_LINE + 1)
+                if not data:
+                    break
+                number += 1
+                if torn is not None:
+                    break
+                line = data.decode("utf-8", errors="replace")
+                if len(data) > MAX_LINE:
+                    fail(f"{path}, line {number}: over {MAX_LINE:,} bytes, not a log row: the log is damaged: {redo}")
+                if not line.strip():
+                    continue
+                try:
+                    row = json.loads(line)
+                except (ValueError, RecursionError):
+                    torn = number
+                    continue
+                if not isinstance(row, dict) or "kind" not in row:
+                    fail(f"{path}, line {number}: not a kage.ppo.train log row (no \"kind\"): delete that line, or "
+                         f"{redo}")
+                if row["kind"] != "eval":
+                    continue
+                problem = eval_row_problem(row)
+                if problem:
+                    fail(f"{path}, line {number}: {problem}: delete that line, or {redo}")
+                if previous[1] is not None and not row["global_step"] > previous[1]:
+                    fail(f"{path}, line {number}: an evaluation row at step {row['global_step']}, not after the one "
+                         f"of line {previous[0]} (step {previous[1]}): the log has duplicated or out-of-order rows, "
+                         f"which kage.ppo.train never writes (an edit, or two trainers in one run directory): delete "
+                         f"the rows out of order, or {redo}")
+                previous = (number, row["global_step"])
+                rows.append(row)
+    except OSError as e:  # NotRegularFile too: a FIFO or a device (a symlink to /dev/zero), too large
+        fail(f"cannot read {path} ({e.strerror or e}): replace it by the run's log, or {redo}")
+    if torn is not None and torn != number:
+        fail(f"{path}, line {torn}: not a JSON row, the log is damaged: delete that line, or {redo}")
     return rows
 
 
@@ -475,6 +540,8 @@ def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
         fail(f"unknown protocol '{protocol}': choose {' or '.join(PROTOCOLS)}")
     if metric not in intervals.METRICS:
         fail(f"the interval estimates take {', '.join(intervals.METRICS)}, not '{metric}'")
+    if intervals.reps_problem(reps):
+        fail(intervals.reps_problem(reps))
     suite, bench, units, runs = read_benchmark(bench_dir)
     out_dir = out_dir or os.path.join(bench_dir, ("report" if protocol == "max" else "report_final")
                                       + ("_interim" if partial else ""))

@@ -41,16 +41,20 @@ from typing import Dict, List, Optional
 from kage import front_end, resources
 from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
-from kage.bench.records import bench_problem, suite_problem
+from kage.bench.records import MAX_SEED, bench_problem, suite_problem, unit_name_problem
 from kage.bench.units import Unit, select, units_of
 from kage.errors import ConfigError
-from kage.util.files import atomic_write, os_error_text, read_json_record, remove_strays, write_json
+from kage.util.files import (LOG_LIMIT, atomic_write, open_regular, os_error_text, read_json_record, read_regular,
+                             remove_strays, write_json)
 from kage.util.lock import DirectoryLock, LockHeld
 from kage.util.stop import child_environment, die_with_parent, stop_children
 
 
+MAX_SEEDS = 1_000_000  # a list of seeds beyond this is a typo (1-10000000000), not a benchmark
+
+
 def parse_seeds(text: str) -> List[int]:
-    """"1-10", "1,3,5" or "7"."""
+    """"1-10", "1,3,5" or "7": at most MAX_SEEDS seeds, each below 2**63 (kage.ppo.train's --seed)."""
     seeds: List[int] = []
     for part in text.split(","):
         m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
@@ -59,6 +63,11 @@ def parse_seeds(text: str) -> List[int]:
         first, last = int(m[1]), int(m[2] or m[1])
         if last < first:
             raise SystemExit(f"kage.bench: --seeds {text!r}: the range {first}-{last} is empty")
+        if last >= MAX_SEED:
+            raise SystemExit(f"kage.bench: --seeds {text!r}: seed {last} is too large: seeds are below 2**63")
+        if len(seeds) + last - first + 1 > MAX_SEEDS:
+            raise SystemExit(f"kage.bench: --seeds {text!r:.80}: more than {MAX_SEEDS:,} seeds, a run each per pair: "
+                             "give fewer seeds")
         seeds.extend(range(first, last + 1))
     return sorted(set(seeds))
 
@@ -78,11 +87,9 @@ def units_to_train(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
 
 
 def check_unit_name(name: str) -> None:
-    """Refuses a pair or sweep name that would not be a folder inside DIR/runs/ (absolute, "..", ".", an empty
-    part, a backslash or a control character), since its runs are written under DIR/runs/<name>/."""
-    parts = name.split("/")
-    if not name or name.startswith("/") or "\\" in name or any(p in ("", ".", "..") for p in parts) or \
-            any(ord(c) < 32 or ord(c) == 127 for c in name):
+    """Refuses a pair or sweep name that would not be a folder inside DIR/runs/ (records.unit_name_problem), since
+    its runs are written under DIR/runs/<name>/."""
+    if unit_name_problem(name):
         raise SystemExit(f"kage.bench: pair or sweep name {name!r}: its runs go to DIR/runs/<name>/, so the name must "
                          "be a relative path of plain parts (no leading '/', no '.' or '..' parts, no empty part, no "
                          "backslash or control character): rename it in the suite")
@@ -176,9 +183,8 @@ def train_flags(unit: Unit, seed: int, run_dir: str, trainer_args: List[str]) ->
 def checkpoint_iteration(run_dir: str) -> int:
     """The iteration of a run's last checkpoint (0 for none)."""
     try:
-        with open(os.path.join(run_dir, "checkpoints", "latest.json")) as f:
-            iteration = json.load(f)["iteration"]
-    except (OSError, ValueError, KeyError, TypeError):
+        iteration = json.loads(read_regular(os.path.join(run_dir, "checkpoints", "latest.json")))["iteration"]
+    except (OSError, ValueError, KeyError, TypeError, RecursionError):  # absent, a FIFO or device, damaged
         return 0
     return iteration if isinstance(iteration, int) and not isinstance(iteration, bool) else 0
 
@@ -231,17 +237,18 @@ class Display:
 def last_progress(metrics_path: str):
     """The global step and steps/s of a run's last training row (0, None before the first)."""
     try:
-        with open(metrics_path, "rb") as f:
-            f.seek(max(0, os.path.getsize(metrics_path) - 65536))
-            lines = f.read().decode(errors="replace").splitlines()
+        with open_regular(metrics_path, LOG_LIMIT) as f:
+            f.seek(max(0, os.fstat(f.fileno()).st_size - 65536))
+            lines = f.read(65536).decode(errors="replace").splitlines()
     except OSError:
         return 0, None
     for line in reversed(lines):
         try:
             row = json.loads(line)
-        except json.JSONDecodeError:
+        except (ValueError, RecursionError):
             continue
-        if row.get("kind") == "train":
+        if isinstance(row, dict) and row.get("kind") == "train" and \
+                all(isinstance(row.get(k), (int, float)) for k in ("global_step", "charts/SPS")):
             return row["global_step"], row["charts/SPS"]
     return 0, None
 

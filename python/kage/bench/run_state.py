@@ -4,12 +4,13 @@ the log's last error line) or "stopped" (the runner was told to stop: Slurm's sc
 A run whose heartbeat is older than STALE_S was killed without a word (SIGKILL, a lost node); a run with
 summary.json is finished whatever its state file says."""
 import json
+import math
 import os
 import socket
 import time
 from typing import List, Optional
 
-from kage.util.files import write_json
+from kage.util.files import LOG_LIMIT, NotRegularFile, open_regular, read_regular, write_json
 
 STATE_FILE = "bench_state.json"
 HEARTBEAT_S = 30.0
@@ -30,9 +31,9 @@ def mark(run_dirs: List[str], state: str, **details) -> None:
 def last_error(log_path: str) -> str:
     """The last non-empty line of a log: a traceback's exception, or kage.ppo.train's message."""
     try:
-        with open(log_path, "rb") as f:
-            f.seek(max(0, os.path.getsize(log_path) - 16384))
-            lines = [line.strip() for line in f.read().decode(errors="replace").splitlines() if line.strip()]
+        with open_regular(log_path, LOG_LIMIT) as f:
+            f.seek(max(0, os.fstat(f.fileno()).st_size - 16384))
+            lines = [line.strip() for line in f.read(16384).decode(errors="replace").splitlines() if line.strip()]
     except OSError as e:
         return f"(no log: {e.strerror})"
     return lines[-1][:500] if lines else "(the log is empty)"
@@ -49,15 +50,18 @@ _REQUIRED = {"state": str, "time": (int, float), "host": str}
 def read(run_dir: str) -> Optional[dict]:
     """The run's state, None where it has none; Damaged for a file that is not a state."""
     try:
-        with open(os.path.join(run_dir, STATE_FILE)) as f:
-            state = json.load(f)
+        state = json.loads(read_regular(os.path.join(run_dir, STATE_FILE)))
     except FileNotFoundError:
         return None
-    except (OSError, ValueError) as e:
+    except NotRegularFile as e:  # a FIFO or a device, which reading would wait on or never finish
+        raise Damaged(e.strerror) from None
+    except (OSError, ValueError, RecursionError) as e:
         raise Damaged(str(e)) from None
     if not isinstance(state, dict):
         raise Damaged(f"a JSON {type(state).__name__}, not an object")
     for key, kind in _REQUIRED.items():
         if not isinstance(state.get(key), kind) or isinstance(state.get(key), bool):
             raise Damaged(f"no valid '{key}'")
+    if not math.isfinite(state["time"]):
+        raise Damaged(f"'time' is {state['time']}, not a time")
     return state

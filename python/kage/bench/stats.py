@@ -79,7 +79,11 @@ class _Layout:
     that weights it: a task's scores are weighted by its group's counts, one count per row the group has."""
 
     def __init__(self, scores, groups: Groups, name: str = "scores"):
-        x = np.asarray(scores, dtype=float)
+        try:
+            x = np.asarray(scores, dtype=float)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"{name} must be a [runs, tasks] matrix of numbers (NaN where a run is missing): "
+                             f"{type(scores).__name__} {str(scores)[:60]!r} is not one ({e})") from None
         if x.ndim != 2 or x.shape[0] == 0 or x.shape[1] == 0:
             raise ValueError(f"{name} must be a [runs, tasks] matrix with at least one run and one task, "
                              f"got shape {x.shape}")
@@ -127,14 +131,19 @@ class _Layout:
         """The weights of the original sample: every run once."""
         return np.ones((1, self.size))
 
-    def resamples(self, rng: np.random.Generator, reps: int) -> Iterator[np.ndarray]:
-        """[chunk, size] weights of `reps` stratified resamples, in chunks: each group draws as many of its rows
-        as it has, with replacement, and a score's weight is how often its row was drawn."""
+    def chunk(self, reps: int) -> int:
+        """Resamples per chunk: about CHUNK_VALUES weights."""
+        return max(1, min(reps, CHUNK_VALUES // self.size))
+
+    def resamples(self, rng: np.random.Generator, reps: int, chunk: Optional[int] = None) -> Iterator[np.ndarray]:
+        """[chunk, size] weights of `reps` stratified resamples, in chunks of `chunk` (default self.chunk(reps)):
+        each group draws as many of its rows as it has, with replacement, and a score's weight is how often its row
+        was drawn. Two layouts resampled side by side (probability_of_improvement) take one chunk size."""
         sizes = np.array(self.group_sizes)
         total = int(sizes.sum())
         high = np.repeat(sizes, sizes)  # per draw: the number of rows of the group it draws for
         first = np.repeat(np.cumsum(sizes) - sizes, sizes)  # and the column of that group's first row
-        chunk = max(1, min(reps, CHUNK_VALUES // self.size))
+        chunk = self.chunk(reps) if chunk is None else chunk
         for start in range(0, reps, chunk):
             count = min(chunk, reps - start)
             # floor(u n) of a uniform u is a uniform row of n (the bias of a 53-bit u is below 1e-13); faster
@@ -183,16 +192,32 @@ def _iqm(weights: np.ndarray, values: np.ndarray) -> np.ndarray:
 
 
 def _check(metrics: Sequence[str], allowed: Sequence[str] = METRICS) -> None:
+    """`metrics`: a list (or tuple) of names of `allowed`. A string would be read letter by letter, and a function
+    (rliable's aggregate_func) is not taken: both are refused naming the argument."""
+    if isinstance(metrics, (str, bytes)) or not isinstance(metrics, (list, tuple)):
+        raise ValueError(f"metrics={metrics!r:.60}: a list of metric names, e.g. ['iqm'] (choose from "
+                         f"{', '.join(allowed)}), not a {type(metrics).__name__}")
     for metric in metrics:
-        if metric not in allowed:
-            raise ValueError(f"unknown metric {metric!r}: choose one of {', '.join(allowed)}")
+        if not isinstance(metric, str) or metric not in allowed:
+            raise ValueError(f"metrics: unknown metric {metric!r:.60}: choose one of {', '.join(allowed)}")
 
 
-def _check_bootstrap(reps: int, confidence: float) -> None:
-    if not (isinstance(reps, (int, np.integer)) and reps >= 1):
-        raise ValueError(f"reps must be a positive integer, got {reps!r}")
-    if not 0.0 < confidence < 1.0:
-        raise ValueError(f"confidence must be between 0 and 1 (0.95 for a 95 % interval), got {confidence!r}")
+def _check_metric(metric: str, allowed: Sequence[str] = METRICS) -> None:
+    """One metric's name, refused naming the argument `metric` where it is not one of `allowed`."""
+    if not isinstance(metric, str) or metric not in allowed:
+        raise ValueError(f"metric: unknown metric {metric!r:.60}: give one name of {', '.join(allowed)}")
+
+
+def _check_bootstrap(reps: int, confidence: float, seed: int = 0) -> None:
+    if not (isinstance(reps, (int, np.integer)) and not isinstance(reps, (bool, np.bool_)) and reps >= 1):
+        raise ValueError(f"reps must be a positive integer, got {reps!r:.60}")
+    if not (isinstance(confidence, (int, float, np.integer, np.floating)) and not isinstance(confidence, bool)
+            and 0.0 < confidence < 1.0):
+        raise ValueError(f"confidence must be between 0 and 1 (0.95 for a 95 % interval), got {confidence!r:.60}")
+    if not (isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)) and seed >= 0):
+        raise ValueError(f"seed={seed!r:.60}: a non-negative integer. The bootstrap draws from a generator of its own "
+                         "seeded with it, so that the same call gives the same interval (rliable's random_state=None, "
+                         "a fresh draw each time, is not offered): give 0, the default, or another integer")
 
 
 def _percentiles(samples: np.ndarray, confidence: float):
@@ -204,7 +229,7 @@ def _percentiles(samples: np.ndarray, confidence: float):
 def aggregate(scores, metric: str) -> float:
     """`metric` ("iqm", "mean", "median" or "optimality_gap", see the module's docstring) of a [runs, tasks]
     score matrix."""
-    _check([metric])
+    _check_metric(metric)
     layout = _Layout(scores, None)
     return float(_statistic(layout, layout.ones(), metric)[0])
 
@@ -221,8 +246,10 @@ def interval_estimates(score_dict: Mapping[str, object], metrics: Sequence[str],
     percentile interval of `reps` stratified resamples (the same resamples for every metric of a name).
     `groups`: one label per task, tasks that share runs having the same label, for every name; or a dict
     {name: labels or None} where the names were run differently; None: no task shares runs."""
+    if not isinstance(score_dict, Mapping):
+        raise ValueError(f"score_dict: a dict {{name: [runs, tasks] scores}}, got a {type(score_dict).__name__}")
     _check(metrics)
-    _check_bootstrap(reps, confidence)
+    _check_bootstrap(reps, confidence, seed)
     results = {}
     for name, scores in score_dict.items():
         name_groups = groups.get(name) if isinstance(groups, Mapping) else groups
@@ -255,14 +282,17 @@ def probability_of_improvement(x, y, reps: int = 50000, confidence: float = 0.95
     """P(X > Y), rliable's probability of improvement of the method with scores `x` ([runs_x, tasks]) over the
     one with `y` ([runs_y, tasks], the same tasks): per task, the probability that a run of X scores above a run
     of Y, ties counting half (the Mann-Whitney U over n_x n_y), averaged over tasks. The interval resamples x's
-    and y's runs independently, each stratified by task (and by `groups_x`, `groups_y`: see the module)."""
-    _check_bootstrap(reps, confidence)
+    and y's runs independently, each stratified by task (and by `groups_x`, `groups_y`: see the module); x and y
+    may have different numbers of runs."""
+    _check_bootstrap(reps, confidence, seed)
     lx, ly = _Layout(x, groups_x, "x"), _Layout(y, groups_y, "y")
     if lx.num_tasks != ly.num_tasks:
         raise ValueError(f"x has {lx.num_tasks} tasks and y {ly.num_tasks}: give both methods' scores on the same "
                          "tasks, in the same order")
     rng = np.random.default_rng(seed)
-    samples = [_improvement(lx, ly, wx, wy) for wx, wy in zip(lx.resamples(rng, reps), ly.resamples(rng, reps))]
+    chunk = min(lx.chunk(reps), ly.chunk(reps))  # one size for both: each chunk pairs x's resamples with y's
+    samples = [_improvement(lx, ly, wx, wy) for wx, wy in zip(lx.resamples(rng, reps, chunk),
+                                                               ly.resamples(rng, reps, chunk))]
     low, high = _percentiles(np.concatenate(samples), confidence)
     return Estimate(float(_improvement(lx, ly, lx.ones(), ly.ones())[0]), float(low), float(high))
 
@@ -271,9 +301,12 @@ def performance_profile(scores, taus, reps: int = 50000, confidence: float = 0.9
                         groups: Groups = None) -> Profile:
     """rliable's score distribution: for each threshold tau, the fraction of all runs of all tasks (pooled)
     whose score is strictly above tau, with stratified bootstrap intervals."""
-    _check_bootstrap(reps, confidence)
+    _check_bootstrap(reps, confidence, seed)
     layout = _Layout(scores, groups)
-    taus = np.asarray(taus, dtype=float).reshape(-1)
+    try:
+        taus = np.asarray(taus, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"taus={taus!r:.60}: the thresholds, numbers (e.g. numpy.linspace(0, 1, 101))") from None
     above = (layout.values[:, None] > taus[None, :]) / layout.size
     samples = np.concatenate([w @ above for w in layout.resamples(np.random.default_rng(seed), reps)])
     low, high = _percentiles(samples, confidence)
@@ -299,8 +332,8 @@ def relative_drop(train, evaluated, metric: str = "mean", reps: int = 50000, con
     Where A(train) is 0 the drop is undefined: the point is None if the sample's train aggregate is 0, and the
     interval is None if any resample's is (for success rates: every resampled run has train success 0), since
     a percentile interval cannot place resamples that have no value; `undefined_fraction` says how many did."""
-    _check([metric], RATIO_METRICS)
-    _check_bootstrap(reps, confidence)
+    _check_metric(metric, RATIO_METRICS)
+    _check_bootstrap(reps, confidence, seed)
     t, e = np.asarray(train, dtype=float), np.asarray(evaluated, dtype=float)
     if t.shape != e.shape or not np.array_equal(np.isnan(t), np.isnan(e)):
         raise ValueError(f"train {t.shape} and evaluated {e.shape} must have the same shape and NaN at the same "

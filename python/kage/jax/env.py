@@ -130,8 +130,12 @@ class JaxEnv:
     def check(self, state: KageState) -> None:
         """Raises ValueError if any step since the reset had an action outside 0..7 (naming the first);
         call it outside ``jit`` (it reads the [N, 2] record from the device), e.g. after a scan. A state with
-        leading vmap axes is checked whole."""
+        leading vmap axes is checked whole. Inside ``jit``, ``vmap`` or ``scan`` it raises TypeError saying so."""
         self._check_state(state, batched=True)
+        if isinstance(state.action_error, jax.core.Tracer):
+            raise TypeError("env.check(state) reads the state's action record back from the device, so it runs outside "
+                            "jax.jit, vmap and scan: call it on the state that your jitted function returns (after the "
+                            "scan, say), not inside it")
         record = np.asarray(jax.device_get(state.action_error))
         hits = np.argwhere(record[..., 1] != 0)
         if hits.size == 0:
@@ -190,7 +194,7 @@ class JaxEnv:
     def _check_actions(self, actions):
         shape, dtype = getattr(actions, "shape", None), getattr(actions, "dtype", None)
         if shape is None or dtype is None:
-            actions = jnp.asarray(actions)
+            actions = _host_actions(actions, self.num_envs)
             shape, dtype = actions.shape, actions.dtype
         if tuple(shape) != (self.num_envs,):
             raise ValueError(f"actions: shape {tuple(shape)}, expected ({self.num_envs},): one action per environment")
@@ -205,14 +209,38 @@ class JaxEnv:
         return out
 
 
+def _host_actions(actions, num_envs: int):
+    """Actions given as a Python sequence (a list of ints): an int32 array, or TypeError / ValueError naming
+    ``actions`` where they are not integers that int32 holds. Strings are refused, not parsed."""
+    expected = f"expected int32 [{num_envs}], one action in 0..7 per environment"
+    if isinstance(actions, (str, bytes)):
+        raise TypeError(f"actions={actions!r:.40}: a {type(actions).__name__}, {expected}")
+    try:
+        values = np.asarray(actions)
+    except (TypeError, ValueError, OverflowError) as e:
+        raise TypeError(f"actions: a {type(actions).__name__} that is not an array of integers ({e}); {expected}") \
+            from None
+    integers = values.dtype.kind in "iu" or (values.dtype.kind == "O" and all(  # "O": ints beyond 64 bits
+        isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values.reshape(-1).tolist()))
+    if not integers:
+        raise TypeError(f"actions: {values.dtype} values ({str(actions)[:40]}), {expected}")
+    big = [int(v) for v in values.reshape(-1).tolist() if not -2**31 <= int(v) < 2**31]
+    if big:
+        raise ValueError(f"actions: {big[0]} does not fit int32 (and actions are 0..7); {expected}")
+    return jnp.asarray(values.astype(np.int32))
+
+
 def make_env(config: Union[str, os.PathLike], num_envs: int, asset_root=None) -> JaxEnv:
     """``num_envs`` environments of ``config`` (a YAML file or a ``kagec compile`` directory) for JAX.
 
     Raises what ``kage.make_vec`` raises for the same config: ``kage.ConfigError`` with kagec's located
     diagnostics, ``FileNotFoundError``, ``ValueError`` for bad arguments. ``asset_root`` as make_vec's.
+    ``num_envs`` has make_vec's limits: at most 2**31 - 1, and no more environments than make_vec builds on
+    the CPU (their states, observations and render scratch within half of the machine's memory), on every
+    backend; beyond them it raises ValueError with make_vec's words before anything is allocated.
     """
-    if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs <= 0:
-        raise ValueError(f"num_envs={num_envs!r}: a positive integer")
+    if not vector._is_integer(num_envs) or not 0 < num_envs <= vector.MAX_INT32:
+        raise ValueError(f"num_envs={num_envs!r}: a positive integer up to {vector.MAX_INT32}")
     # One CPU environment of make_vec: its errors, its resolved path and the dtypes of its outputs.
     probe = vector.make_vec(config, 1, device="cpu", threads=1, asset_root=asset_root)
     try:
@@ -228,4 +256,7 @@ def make_env(config: Union[str, os.PathLike], num_envs: int, asset_root=None) ->
     if sizes["spec_hash"] != spec_hash:
         raise RuntimeError(f"kage.jax: {path} has spec hash {sizes['spec_hash']} here but {spec_hash} in make_vec: "
                            "kage._kage and kage._kage_jax come from different builds; reinstall")
+    refusal = _native.module().memory_refusal(spec_hash, int(num_envs))
+    if refusal:
+        raise ValueError(f"kage.jax.make_env: num_envs={int(num_envs)}: {refusal}")
     return JaxEnv(path, int(num_envs), sizes, dtypes)

@@ -11,7 +11,6 @@ import functools
 import jax.numpy as jnp
 import numpy as np
 
-_MASK = 0xFFFFFFFF
 _INIT_A, _MULT_A = 0x43B0D7E5, 0x931E8875  # the pool's hash constants
 _INIT_B, _MULT_B = 0x8B51F9DD, 0x58F38DED  # the output's hash constants
 _MIX_L, _MIX_R = 0xCA01F9DD, 0x4973F715
@@ -19,12 +18,11 @@ _POOL = 4
 
 
 def _powers(init: int, mult: int, count: int) -> np.ndarray:
-    """init * mult**k mod 2**32 for k = 0 .. count-1 (the hash constant before each use)."""
-    out, h = [], init
-    for _ in range(count):
-        out.append(h)
-        h = (h * mult) & _MASK
-    return np.array(out, dtype=np.uint32)
+    """init * mult**k mod 2**32 for k = 0 .. count-1 (the hash constant before each use): a running product in
+    uint32, which wraps modulo 2**32 (one pass in numpy: a batch's 2 N constants in milliseconds)."""
+    factors = np.full(count, mult, dtype=np.uint32)
+    factors[:1] = init
+    return np.cumprod(factors, dtype=np.uint32)
 
 
 def _u32(x: int):

@@ -22,7 +22,10 @@ from typing import Any, List, Optional
 import numpy as np
 import torch
 
+from kage.util.files import NotRegularFile, open_regular
+
 FORMAT = "kage.ppo.checkpoint/2"
+LIMIT = 1 << 40  # bytes: a cap only against a file that never ends; a checkpoint is what its run holds
 
 
 class CheckpointError(Exception):
@@ -72,9 +75,13 @@ def digest(text: bytes, tensors: List[torch.Tensor]) -> str:
 def load(path: str) -> dict:
     """The state saved at `path`, read as data only; CheckpointError names the file and what is wrong."""
     try:
-        raw = torch.load(path, map_location="cpu", weights_only=True)
+        with open_regular(path, LIMIT) as f:  # a FIFO or a device is refused, not waited on or read forever
+            raw = torch.load(f, map_location="cpu", weights_only=True)
     except FileNotFoundError:
         raise CheckpointError(f"{path}: no such file") from None
+    except NotRegularFile as e:
+        raise CheckpointError(f"{path}: {e.strerror}: give the checkpoints/latest.pt that kage.ppo.train wrote") \
+            from None
     except Exception as e:  # torch raises many kinds on a damaged, foreign or code-carrying file
         older = ("; a checkpoint of an older kage.ppo.train (a pickled dict) reads as data only with torch 2.x"
                  if int(torch.__version__.split(".")[0]) < 2 else "")

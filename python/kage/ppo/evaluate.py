@@ -28,7 +28,7 @@ from kage.ppo.args import MAX_INT32
 from kage.errors import ConfigError
 from kage.util import tables
 from kage.ppo.evaluation import METRICS, EvalSettings, evaluate, evaluation_seed
-from kage.util.files import atomic_write, os_error_text, output_folder, write_json
+from kage.util.files import atomic_write, os_error_text, output_folder, read_regular, write_json
 
 CONFIG_COLUMNS = ("episodes", "return", "length", "success_once", "success", "passed_distance", "progress",
                   "jump_count", "x", "y", "vx_mean", "vy_mean")
@@ -40,6 +40,9 @@ def fail(message: str):
 
 def checkpoint_file(path: str) -> str:
     file = os.path.join(path, "checkpoints", "latest.pt") if os.path.isdir(path) else path
+    if os.path.exists(file) and not os.path.isfile(file):
+        fail(f"{file} is not a regular file (a FIFO or a device?): give a kage.ppo.train run directory or its "
+             "checkpoints/latest.pt")
     if not os.path.isfile(file):
         fail(f"{file} not found: give a kage.ppo.train run directory or its checkpoints/latest.pt")
     return file
@@ -106,11 +109,9 @@ def spec_from_run_dir(file: str) -> dict:
     from its run directory: run.json's arguments and the train config's resolved Spec."""
     run_dir = os.path.dirname(os.path.dirname(os.path.abspath(file)))
     try:
-        with open(os.path.join(run_dir, "run.json")) as f:
-            args = json.load(f)["args"]
-        with open(os.path.join(run_dir, "configs", "train.json")) as f:
-            config = json.load(f)["config"]
-    except (OSError, ValueError, KeyError) as e:
+        args = json.loads(read_regular(os.path.join(run_dir, "run.json")))["args"]
+        config = json.loads(read_regular(os.path.join(run_dir, "configs", "train.json")))["config"]
+    except (OSError, ValueError, KeyError, TypeError, RecursionError) as e:
         fail(f"{file} does not name its network, and its run directory {run_dir} cannot tell it ({e}): give the "
              "checkpoint inside its kage.ppo.train run directory")
     channels = 3 * (4 if args["use_frame_stack"] else 1)

@@ -5,7 +5,11 @@ The content goes to a temporary file beside the target, NAME.tmp.<host>.<pid>.<r
 (an existing file or a planted symlink at that name makes the create fail instead of being followed),
 unpredictable, removed when the write fails (a full disk keeps no stray), and named by its writer, so that
 remove_strays can tell a dead writer's leftovers from a live one's (processes of several hosts may share a
-directory: a Slurm array)."""
+directory: a Slurm array).
+
+Files that are read back (a run's records, logs and checkpoints) are opened with open_regular: only a regular
+file (or a symlink to one) is read, and only up to a size cap, so that a log that is a symlink to /dev/zero
+or a FIFO is refused at once instead of filling the memory or waiting forever."""
 import contextlib
 import errno
 import json
@@ -13,8 +17,9 @@ import os
 import re
 import secrets
 import socket
+import stat
 import time
-from typing import Any, Callable, Optional, Tuple
+from typing import Any, BinaryIO, Callable, Iterator, Optional, Tuple
 
 STRAY_AGE_S = 3600  # another host's temporary file this old is a dead writer's: a write takes seconds
 _TEMPORARY = re.compile(r"^.+\.tmp\.(?P<host>[^/]+?)\.(?P<pid>\d+)(?:\.[0-9a-f]+)?$")
@@ -118,14 +123,67 @@ def process_alive(pid: int) -> bool:
     return True
 
 
+RECORD_LIMIT = 64 << 20  # a JSON record (bench.json, suite.json, run.json, summary.json, a state): ~1000x a real one
+LOG_LIMIT = 4 << 30  # a metrics.jsonl (a long run's is tens of MB)
+
+
+class NotRegularFile(OSError):
+    """A file that a reader refuses before reading it: not a regular file (a FIFO, a device, a directory, a
+    socket; through a symlink too), or larger than the reader's cap. Its strerror says which."""
+
+    def __str__(self) -> str:
+        return f"{self.filename}: {self.strerror}"
+
+
+def _kind(mode: int) -> str:
+    for test, name in ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISDIR, "a directory"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return "not a regular file"
+
+
+@contextlib.contextmanager
+def open_regular(path: str, limit: int) -> Iterator[BinaryIO]:
+    """`path` opened for reading in binary, where it is a regular file (a symlink to one is fine) of at most
+    `limit` bytes; NotRegularFile (an OSError naming `path`) otherwise, before anything is read. Opened without
+    blocking, so that a FIFO is refused at once instead of waiting for a writer."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            target = f" (a symlink to {os.path.realpath(path)})" if os.path.islink(path) else ""
+            raise NotRegularFile(errno.EINVAL, f"{_kind(info.st_mode)}{target}, not a regular file", path)
+        if info.st_size > limit:
+            raise NotRegularFile(errno.EFBIG, f"{info.st_size:,} bytes, more than such a file can be ({limit:,})",
+                                 path)
+        os.set_blocking(fd, True)
+        f = os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+    with f:
+        yield f
+
+
+def read_regular(path: str, limit: int = RECORD_LIMIT) -> bytes:
+    """The content of the regular file `path`, at most `limit` bytes (open_regular's refusals)."""
+    with open_regular(path, limit) as f:
+        data = f.read(limit + 1)
+    if len(data) > limit:  # it grew while being read
+        raise NotRegularFile(errno.EFBIG, f"more than such a file can be ({limit:,} bytes)", path)
+    return data
+
+
 def read_json_record(path: str, problem_of: Callable[[Any], Optional[str]]) -> Tuple[Any, Optional[str]]:
     """A JSON record's value and what is wrong with it (not JSON, or `problem_of`'s answer; None when nothing is),
-    for the caller to refuse in its own words. OSError passes through."""
-    with open(path) as f:
-        try:
-            value = json.load(f)
-        except ValueError as e:  # UnicodeDecodeError too
-            return None, f"not JSON ({e})"
+    for the caller to refuse in its own words. OSError passes through (NotRegularFile for a FIFO, a device or a
+    file larger than RECORD_LIMIT)."""
+    data = read_regular(path)
+    try:
+        value = json.loads(data)
+    except (ValueError, RecursionError) as e:  # UnicodeDecodeError too; RecursionError: nesting too deep
+        return None, f"not JSON ({e})"
     return value, problem_of(value)
 
 

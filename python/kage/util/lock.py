@@ -20,7 +20,7 @@ import threading
 import time
 from typing import Optional
 
-from kage.util.files import create_temporary, named_errors, process_alive
+from kage.util.files import create_temporary, named_errors, process_alive, read_regular
 
 HEARTBEAT_S = 30.0
 STALE_S = 4 * HEARTBEAT_S
@@ -92,15 +92,14 @@ class DirectoryLock:
     def read(self) -> Optional[dict]:
         """The holder's description; {} for a lock whose content cannot be read; None when there is no lock."""
         try:
-            with open(self.path) as f:
-                text = f.read()
+            text = read_regular(self.path, 1 << 20)  # a FIFO or a device reads as no holder, never waited on
         except FileNotFoundError:
             return None
         except OSError:
             return {}
         try:
             holder = json.loads(text)
-        except ValueError:
+        except (ValueError, RecursionError):
             return {}
         return holder if isinstance(holder, dict) else {}
 
