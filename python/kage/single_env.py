@@ -70,6 +70,6 @@ class SingleEnv(gymnasium.Env):
 
 def _row(info: Dict[str, Any]) -> Dict[str, Any]:
     """Row 0 of a batch's info fields, as Python scalars."""
-    from kage.vector import INFO_FIELDS
+    from kage.vector import INFO_NAMES
 
-    return {name: np.asarray(info[name])[0].item() for name, _, _ in INFO_FIELDS}
+    return {name: np.asarray(info[name])[0].item() for name in INFO_NAMES}

@@ -8,7 +8,7 @@ import torch
 
 from kage.ppo import plugins, tensorboard_log
 from kage.ppo.augment import PAD, random_shift
-from kage.ppo.evaluation import METRICS
+from kage.fields import EPISODE_METRICS
 
 SHAPE = (16, 16, 3)
 
@@ -64,7 +64,7 @@ def test_random_shift_moves_each_frame_by_its_own_offset():
 
 
 def eval_result(base: float) -> dict:
-    result = {m: base + i for i, m in enumerate(METRICS)}
+    result = {m: base + i for i, m in enumerate(EPISODE_METRICS)}
     result.update({"return": base - 100, "length": 500.0, "episodes": 128})
     return result
 

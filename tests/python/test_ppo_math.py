@@ -8,7 +8,8 @@ import torch
 from kage.ppo.agent import Agent
 from kage.ppo.args import Args
 from kage.ppo.counter_random import CounterRandom
-from kage.ppo.evaluation import METRICS, EpisodeMetrics, summarize_evaluation
+from kage.fields import RECORD_COLUMNS
+from kage.ppo.evaluation import COLUMN, EpisodeMetrics, summarize_evaluation
 from kage.ppo.losses import clip_grad_norm_per_run, compute_gae, entropy_of, ppo_loss
 from kage.ppo.policy import sample_gumbel_max
 
@@ -123,22 +124,24 @@ def test_gradient_clipping_is_per_run():
 
 
 def test_evaluation_summary_follows_the_protocol():
-    # [steps, 12, envs]: rows = finished, return, length, then METRICS. Two environments, three steps:
+    # [steps, columns, envs], the columns named by kage.fields.RECORD_COLUMNS. Two environments, three steps:
     # step 1: env 0 ends (return 10); step 2: env 0 ends with return 0 and env 1 with return 6.
-    records = torch.zeros(3, 12, 2)
-    x = 3 + METRICS.index("x")
-    records[1, :3, 0] = torch.tensor([1.0, 10.0, 2.0])
+    records = torch.zeros(3, len(RECORD_COLUMNS), 2)
+    head = [COLUMN["finished"], COLUMN["return"], COLUMN["length"]]
+    x = COLUMN["x"]
+    records[1, head, 0] = torch.tensor([1.0, 10.0, 2.0])
     records[1, x, 0] = 1.0
-    records[2, :3, 0] = torch.tensor([1.0, 0.0, 2.0])
+    records[2, head, 0] = torch.tensor([1.0, 0.0, 2.0])
     records[2, x, 0] = 2.0
-    records[2, :3, 1] = torch.tensor([1.0, 6.0, 2.0])
+    records[2, head, 1] = torch.tensor([1.0, 6.0, 2.0])
     records[2, x, 1] = 3.0
     result = summarize_evaluation(records, episodes=2)
     # The list holds the first two episodes (10 and 0); the zero return is dropped: return 10, length 2.
     assert result["return"] == 10.0 and result["length"] == 2.0
     # The metric sums take every episode up to the step where the count reached 2: (1 + 2 + 3) / 3.
     assert result["x"] == 2.0 and result["episodes"] == 3
-    only_zero = summarize_evaluation(records[:, :, :1].clone().index_fill_(1, torch.tensor([1]), 0.0), episodes=1)
+    only_zero = summarize_evaluation(records[:, :, :1].clone().index_fill_(1, torch.tensor([COLUMN["return"]]), 0.0),
+                                     episodes=1)
     assert only_zero["return"] is None and only_zero["length"] is None
 
 
@@ -150,8 +153,8 @@ def test_success_is_strict_at_the_terminal_state():
                    "passed_distance": np.array([490.0, 491.0, 12.0], dtype=np.float32)})
     info = {"_final": np.array([1, 1, 1], dtype=np.uint8), "final_info": fields}
     rows = EpisodeMetrics([info], [490.0], "cpu").rows()[0]
-    assert rows[3 + METRICS.index("success")].tolist() == [0.0, 1.0, 0.0]  # 490 > 490 is false (QUIRK)
-    assert rows[3 + METRICS.index("success_once")].tolist() == [1.0, 1.0, 0.0]
+    assert rows[COLUMN["success"]].tolist() == [0.0, 1.0, 0.0]  # 490 > 490 is false (QUIRK)
+    assert rows[COLUMN["success_once"]].tolist() == [1.0, 1.0, 0.0]
 
 
 def test_space_to_depth_conv1_equals_the_8x8_convolution():

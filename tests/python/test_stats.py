@@ -90,12 +90,12 @@ def test_same_seed_same_intervals_and_no_global_state():
     rng = np.random.default_rng(3)
     scores = {"a": rng.random((5, 4)), "b": rng.random((5, 4))}
     before = np.random.get_state()[1].copy()
-    first = stats.interval_estimates(scores, stats.METRICS, reps=2000, seed=7)
+    first = stats.interval_estimates(scores, stats.AGGREGATES, reps=2000, seed=7)
     assert np.array_equal(np.random.get_state()[1], before)  # numpy's global generator untouched
-    assert stats.interval_estimates(scores, stats.METRICS, reps=2000, seed=7) == first
+    assert stats.interval_estimates(scores, stats.AGGREGATES, reps=2000, seed=7) == first
     # A name's interval does not depend on the other names in the dict.
-    assert stats.interval_estimates({"b": scores["b"]}, stats.METRICS, reps=2000, seed=7)["b"] == first["b"]
-    assert stats.interval_estimates(scores, stats.METRICS, reps=2000, seed=8) != first
+    assert stats.interval_estimates({"b": scores["b"]}, stats.AGGREGATES, reps=2000, seed=7)["b"] == first["b"]
+    assert stats.interval_estimates(scores, stats.AGGREGATES, reps=2000, seed=8) != first
     x, y = scores["a"], scores["b"]
     assert stats.probability_of_improvement(x, y, reps=500, seed=1) == stats.probability_of_improvement(
         x, y, reps=500, seed=1)

@@ -3,6 +3,8 @@ import argparse
 import sys
 from typing import List, Optional
 
+from kage.fields import INTERVAL_METRICS, SUCCESS_SHOWN
+
 
 def main(argv: Optional[List[str]] = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
@@ -24,7 +26,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     report.add_argument("--protocol", choices=("max", "final"), default="max",
                         help="a run's value: its maximum over training (the paper's) or its last evaluation")
     report.add_argument("--reps", type=int, default=50000, help="bootstrap resamples of the interval estimates")
-    report.add_argument("--metric", choices=("success_once", "success", "progress"), default="success_once",
+    report.add_argument("--metric", choices=INTERVAL_METRICS, default=SUCCESS_SHOWN,
                         help="the metric of the interval estimates and profiles")
     report.add_argument("--partial", action="store_true",
                         help="an interim report: unfinished runs too, at their latest evaluation "

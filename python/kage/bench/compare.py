@@ -37,7 +37,8 @@ from typing import Dict, List, NoReturn, Optional, Set, Tuple
 from kage.bench import intervals, plots, report, stats
 from kage.bench.interval_tables import explanation, fmt_drop, fmt_interval, intervals_csv
 from kage.util.files import atomic_write, output_folder
-from kage.util.tables import SUCCESS_SHOWN, csv_text, md_table
+from kage.fields import INTERVAL_METRICS, SUCCESS_SHOWN
+from kage.util.tables import csv_text, md_table
 
 SCHEDULE_ARGS = ("total_timesteps", "eval_every_steps", "eval_episodes", "eval_num_envs", "eval_greedy")
 
@@ -261,8 +262,8 @@ def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optiona
         fail("give two or more benchmark directories")
     if protocol not in report.PROTOCOLS:
         fail(f"unknown protocol '{protocol}': choose {' or '.join(report.PROTOCOLS)}")
-    if metric not in intervals.METRICS:
-        fail(f"--metric takes {', '.join(intervals.METRICS)}, not '{metric}'")
+    if metric not in INTERVAL_METRICS:
+        fail(f"--metric takes {', '.join(INTERVAL_METRICS)}, not '{metric}'")
     if intervals.reps_problem(reps):
         fail(intervals.reps_problem(reps))
     methods = [load(d, name, protocol) for d, name in zip(dirs, method_names(dirs, names))]
@@ -315,7 +316,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser.add_argument("--protocol", choices=report.PROTOCOLS, default="max",
                         help="a run's value: its maximum over training (the paper's) or its last evaluation")
     parser.add_argument("--reps", type=int, default=intervals.REPS, help="bootstrap resamples of the intervals")
-    parser.add_argument("--metric", choices=intervals.METRICS, default=SUCCESS_SHOWN,
+    parser.add_argument("--metric", choices=INTERVAL_METRICS, default=SUCCESS_SHOWN,
                         help="the eval metric compared (default success_once)")
     args = parser.parse_args(argv)
     result = compare(args.dirs, args.names, args.out, args.protocol, args.reps, args.metric)

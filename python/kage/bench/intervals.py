@@ -8,8 +8,8 @@
 - the performance profile over all plain pairs: the fraction of runs whose score is above each threshold.
 
 A run's score is the report's level-1 value (kage.bench.report: the maximum over training or the last evaluation) of
-`success_once`, or of another metric of METRICS (--metric: at a few thousand steps no agent succeeds, while its
-progress already differs).
+`success_once`, or of another metric of kage.fields.INTERVAL_METRICS (--metric: at a few thousand steps no agent
+succeeds, while its progress already differs).
 The pairs are the tasks and the seeds the runs; a pair missing a seed has a gap there. A run depends only on its
 train config, seed and flags, so the pairs of one train config have the same runs: one shared run under
 --share-training, or identical separate runs without it (the 34 KAGE-Bench pairs have 7 train configs). Their
@@ -23,7 +23,7 @@ from typing import Dict, List, NamedTuple, Optional
 import numpy as np
 
 from kage.bench import stats
-from kage.util.tables import SUCCESS_SHOWN
+from kage.fields import SUCCESS_SHOWN
 
 CONFIDENCE = 0.95
 REPS = 50000
@@ -31,7 +31,6 @@ MAX_REPS = 10_000_000  # beyond it the bounds move in the fourth digit only, and
 SEED = 0
 TAUS = np.arange(101) / 100  # 0, 0.01, ..., 1: each the double nearest its decimal
 ALL_PAIRS = "all pairs"
-METRICS = (SUCCESS_SHOWN, "success", "progress")  # shares of episodes or of the distance: the profile's 0..1 fits
 
 
 class Scores(NamedTuple):

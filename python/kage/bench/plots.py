@@ -29,6 +29,8 @@ display or backend setting is involved.
 import io
 from typing import Dict, List, Optional, Sequence, Tuple
 
+from kage.fields import SUCCESS_SHOWN
+
 TRAIN_COLOUR, EVAL_COLOUR = "#1f77b4", "#d62728"
 METHOD_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#7f7f7f")
 BAND_ALPHA = 0.18
@@ -126,7 +128,7 @@ def sweep_response(title: str, names: List[str], evaluated: List[dict], train: d
     return png_bytes(figure, interim)
 
 
-def interval_estimates(methods: Dict[str, List[dict]], metric: str = "success_once",
+def interval_estimates(methods: Dict[str, List[dict]], metric: str = SUCCESS_SHOWN,
                        interim: Optional[str] = None) -> bytes:
     """Per row of kage.bench.intervals (the axes, then all pairs), a bar over each method's 95 % interval and a
     black tick at its point: the IQM of eval `metric` on the left, its drop (%) on the right. `methods` maps a
@@ -160,7 +162,7 @@ def interval_estimates(methods: Dict[str, List[dict]], metric: str = "success_on
 
 
 def performance_profiles(taus: Sequence[float], curves: Dict[str, dict], dashed: Sequence[str] = (),
-                         metric: str = "success_once", interim: Optional[str] = None) -> bytes:
+                         metric: str = SUCCESS_SHOWN, interim: Optional[str] = None) -> bytes:
     """Per curve ({"point", "low", "high"} per threshold), the fraction of runs whose `metric` exceeds each
     threshold tau, with its 95 % band; the curves named in `dashed` drawn dashed."""
     figure, ax = new_figure()

@@ -70,10 +70,10 @@ from typing import Dict, List, NoReturn, Optional, Sequence, Set, Tuple
 from kage.bench import intervals, plots
 from kage.bench.records import bench_problem, suite_problem
 from kage.bench.units import Unit, units_of
-from kage.bench.tables import METRICS, PROTOCOL_TEXTS, SUCCESS_SHOWN, write_tables
+from kage.bench.tables import PROTOCOL_TEXTS, write_tables
+from kage.fields import DIFF_METRICS, INTERVAL_METRICS, REPORT_METRICS, SUCCESS_SHOWN
 from kage.util.files import LOG_LIMIT, RECORD_LIMIT, atomic_write, open_regular, output_folder, read_regular, safe
 
-DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # as kage.ppo.train logs
 PROTOCOLS = ("max", "final")
 LEVEL_1 = {"max": "per run, each value's maximum over its evaluation points (summary.json max), every side maximised "
                   "independently",
@@ -337,7 +337,7 @@ def run_scores(values: dict, label: str, where: str = "summary.json") -> Dict[st
     """Level 1: per metric, the run's value (run_values) of the train side, of the eval side `label` and of
     their absolute difference, each on its own; and the gap and drop of the two."""
     scores = {}
-    for m in METRICS:
+    for m in REPORT_METRICS:
         train = value_of(values, f"train/{m}", where)
         evaluated = value_of(values, f"eval/{label}/{m}", where)
         gap, drop = gap_and_drop(train, evaluated)
@@ -350,7 +350,7 @@ def combine(samples: List[Dict[str, dict]]) -> Dict[str, dict]:
     """Per metric, the mean and SEM of each side over `samples` ({metric: {"train", "eval", "max_abs_diff"}}
     numbers), and the gap and drop of the two means."""
     combined = {}
-    for m in METRICS:
+    for m in REPORT_METRICS:
         train = mean_sem([s[m]["train"] for s in samples])
         evaluated = mean_sem([s[m]["eval"] for s in samples])
         gap, drop = gap_and_drop(train["mean"], evaluated["mean"])
@@ -367,7 +367,7 @@ def over_seeds(run_values: List[Dict[str, dict]]) -> Dict[str, dict]:
 def over_pairs(pair_values: List[Dict[str, dict]]) -> Dict[str, dict]:
     """Level 3: the per-pair means of an axis's pairs (over_seeds), each pair weighted equally."""
     means = [{m: {side: (v[m][side]["mean"] if v[m][side] else None) for side in ("train", "eval", "max_abs_diff")}
-              for m in METRICS} for v in pair_values]
+              for m in REPORT_METRICS} for v in pair_values]
     return combine(means)
 
 
@@ -538,8 +538,8 @@ def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
     and returns report.json's content. `reps`: bootstrap resamples of the interval estimates of `metric`."""
     if protocol not in PROTOCOLS:
         fail(f"unknown protocol '{protocol}': choose {' or '.join(PROTOCOLS)}")
-    if metric not in intervals.METRICS:
-        fail(f"the interval estimates take {', '.join(intervals.METRICS)}, not '{metric}'")
+    if metric not in INTERVAL_METRICS:
+        fail(f"the interval estimates take {', '.join(INTERVAL_METRICS)}, not '{metric}'")
     if intervals.reps_problem(reps):
         fail(intervals.reps_problem(reps))
     suite, bench, units, runs = read_benchmark(bench_dir)
@@ -561,7 +561,7 @@ def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
             "max_abs_diff": "per run the largest |train - eval| at one evaluation point, aggregated like a value"
                             if protocol == "max" else "per run |train - eval| at its last evaluation point",
         },
-        "metrics": list(METRICS), "markdown_success_column": SUCCESS_SHOWN,
+        "metrics": list(REPORT_METRICS), "markdown_success_column": SUCCESS_SHOWN,
         "runs_found": status, "interim": interim_line(status), "levels": levels,
         "intervals": intervals.interval_report(levels["runs"], levels["pairs"], reps, metric) if levels["pairs"]
         else None,

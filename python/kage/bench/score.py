@@ -15,6 +15,7 @@ from kage import front_end, resources
 from kage.bench import report, tables
 from kage.bench.units import select, units_of
 from kage.errors import ConfigError
+from kage.fields import SUCCESS_SHOWN
 from kage.ppo import rundir
 from kage.ppo.evaluate import add_scoring_arguments, fail, load_for_scoring, open_env, result_of, settings_of
 from kage.ppo.evaluation import EvalTargets, evaluation_rows
@@ -43,8 +44,8 @@ def score_suite(agent, spec: dict, file: str, state: dict, options) -> dict:
         for env in envs.values():
             env.close()
         runs[unit.name] = [report.Run(options.seed, file, rundir.summarize([row])["stats"], [row])]
-        shown = ", ".join(f"{label} {row['evals'][label]['success_once']:.2f}" for label in row["evals"])
-        print(f"[{index}/{len(units)}] {unit.name}: success_once train {row['train']['success_once']:.2f}, {shown}",
+        shown = ", ".join(f"{label} {row['evals'][label][SUCCESS_SHOWN]:.2f}" for label in row["evals"])
+        print(f"[{index}/{len(units)}] {unit.name}: {SUCCESS_SHOWN} train {row['train'][SUCCESS_SHOWN]:.2f}, {shown}",
               file=sys.stderr)
     levels = report.aggregate(units, runs)
     status = {"finished": len(units), "unfinished": [], "not_started": []}

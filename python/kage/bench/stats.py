@@ -41,8 +41,8 @@ from typing import Dict, Hashable, Iterator, List, Mapping, NamedTuple, Optional
 
 import numpy as np
 
-METRICS = ("iqm", "mean", "median", "optimality_gap")
-RATIO_METRICS = ("iqm", "mean", "median")  # an optimality gap is not a level a drop can be taken of
+AGGREGATES = ("iqm", "mean", "median", "optimality_gap")  # statistics over runs and tasks, not episode metrics
+RATIO_AGGREGATES = ("iqm", "mean", "median")  # an optimality gap is not a level a drop can be taken of
 CHUNK_VALUES = 1 << 20  # resamples are computed in chunks of about this many weights (8 MB)
 
 Groups = Optional[Sequence[Hashable]]
@@ -173,7 +173,7 @@ def _statistic(layout: _Layout, weights: np.ndarray, metric: str, values: Option
         return 1.0 - weights @ np.minimum(values, 1.0) / n
     if metric == "iqm":
         return _iqm(weights, values)
-    raise ValueError(f"unknown metric {metric!r}: choose one of {', '.join(METRICS)}")
+    raise ValueError(f"unknown metric {metric!r}: choose one of {', '.join(AGGREGATES)}")
 
 
 def _iqm(weights: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -191,7 +191,7 @@ def _iqm(weights: np.ndarray, values: np.ndarray) -> np.ndarray:
     return total / (n - 2 * cut)
 
 
-def _check(metrics: Sequence[str], allowed: Sequence[str] = METRICS) -> None:
+def _check(metrics: Sequence[str], allowed: Sequence[str] = AGGREGATES) -> None:
     """`metrics`: a list (or tuple) of names of `allowed`. A string would be read letter by letter, and a function
     (rliable's aggregate_func) is not taken: both are refused naming the argument."""
     if isinstance(metrics, (str, bytes)) or not isinstance(metrics, (list, tuple)):
@@ -202,7 +202,7 @@ def _check(metrics: Sequence[str], allowed: Sequence[str] = METRICS) -> None:
             raise ValueError(f"metrics: unknown metric {metric!r:.60}: choose one of {', '.join(allowed)}")
 
 
-def _check_metric(metric: str, allowed: Sequence[str] = METRICS) -> None:
+def _check_metric(metric: str, allowed: Sequence[str] = AGGREGATES) -> None:
     """One metric's name, refused naming the argument `metric` where it is not one of `allowed`."""
     if not isinstance(metric, str) or metric not in allowed:
         raise ValueError(f"metric: unknown metric {metric!r:.60}: give one name of {', '.join(allowed)}")
@@ -332,7 +332,7 @@ def relative_drop(train, evaluated, metric: str = "mean", reps: int = 50000, con
     Where A(train) is 0 the drop is undefined: the point is None if the sample's train aggregate is 0, and the
     interval is None if any resample's is (for success rates: every resampled run has train success 0), since
     a percentile interval cannot place resamples that have no value; `undefined_fraction` says how many did."""
-    _check_metric(metric, RATIO_METRICS)
+    _check_metric(metric, RATIO_AGGREGATES)
     _check_bootstrap(reps, confidence, seed)
     t, e = np.asarray(train, dtype=float), np.asarray(evaluated, dtype=float)
     if t.shape != e.shape or not np.array_equal(np.isnan(t), np.isnan(e)):

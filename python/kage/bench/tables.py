@@ -5,12 +5,10 @@ import os
 from typing import List, Optional
 
 from kage.bench.interval_tables import intervals_csv, md_intervals
+from kage.fields import MARKDOWN_METRICS, REPORT_METRICS, SUCCESS_NOTE, SUCCESS_SHOWN
 from kage.util.files import atomic_write
-from kage.util.tables import SUCCESS_NOTE, SUCCESS_SHOWN, csv_text, decimals, fmt_value, md_table
+from kage.util.tables import csv_text, decimals, fmt_value, md_table
 
-METRICS = ("passed_distance", "progress", "success", "success_once", "return", "length", "jump_count")
-MARKDOWN_METRICS = (("success", SUCCESS_SHOWN), ("distance", "passed_distance"), ("progress", "progress"),
-                    ("return", "return"))
 RETURN_NOTE = ("The return is negative for most policies, so its drop is a percentage of a negative train return: "
                "read the gap.")
 NOTES = {SUCCESS_SHOWN: SUCCESS_NOTE, "return": RETURN_NOTE}
@@ -27,18 +25,19 @@ def value_cells(v: dict) -> list:
 
 
 def pairs_csv(pairs: List[dict]) -> str:
-    rows = [[p["pair"], p["axis"], m, p["n_seeds"], *value_cells(p["metrics"][m])] for p in pairs for m in METRICS]
+    rows = [[p["pair"], p["axis"], m, p["n_seeds"], *value_cells(p["metrics"][m])]
+            for p in pairs for m in REPORT_METRICS]
     return csv_text(("pair", "axis", "metric", "n_seeds") + VALUE_COLUMNS + DIFF_COLUMNS, rows)
 
 
 def axes_csv(axes: List[dict]) -> str:
-    rows = [[a["axis"], m, a["n_pairs"], *value_cells(a["metrics"][m])] for a in axes for m in METRICS]
+    rows = [[a["axis"], m, a["n_pairs"], *value_cells(a["metrics"][m])] for a in axes for m in REPORT_METRICS]
     return csv_text(("axis", "metric", "n_pairs") + VALUE_COLUMNS + DIFF_COLUMNS, rows)
 
 
 def sweeps_csv(sweeps: List[dict]) -> str:
     rows = [[s["sweep"], e["sweep_eval"], s["axis"], m, e["n_seeds"], *value_cells(e["metrics"][m])]
-            for s in sweeps for e in s["evals"] for m in METRICS]
+            for s in sweeps for e in s["evals"] for m in REPORT_METRICS]
     return csv_text(("sweep", "sweep_eval", "axis", "metric", "n_seeds") + VALUE_COLUMNS + DIFF_COLUMNS, rows)
 
 

@@ -26,12 +26,12 @@ from kage import resources
 from kage.ppo import checkpoint, plugins, rundir, video
 from kage.ppo.args import MAX_INT32
 from kage.errors import ConfigError
+from kage.fields import EPISODE_METRICS, SCORER_MARKDOWN, SCORER_METRICS, SUCCESS_NOTE
 from kage.util import tables
-from kage.ppo.evaluation import METRICS, EvalSettings, evaluate, evaluation_seed
+from kage.ppo.evaluation import EvalSettings, evaluate, evaluation_seed
 from kage.util.files import atomic_write, os_error_text, output_folder, read_regular, write_json
 
-CONFIG_COLUMNS = ("episodes", "return", "length", "success_once", "success", "passed_distance", "progress",
-                  "jump_count", "x", "y", "vx_mean", "vy_mean")
+CONFIG_COLUMNS = ("episodes",) + SCORER_METRICS  # configs.csv; configs.md shows the episodes and SCORER_MARKDOWN
 
 
 def fail(message: str):
@@ -161,10 +161,11 @@ def settings_of(spec: dict, options) -> EvalSettings:
 
 def write_config_tables(out: str, results: List[dict], header: str) -> List[str]:
     rows = [[r["config"]] + [r[c] for c in CONFIG_COLUMNS] for r in results]
-    markdown = tables.md_table(("config",) + CONFIG_COLUMNS[:8],
-                               [[r[0], r[1]] + [tables.fmt_value(v) for v in r[2:9]] for r in rows], 1)
+    markdown = tables.md_table(("config", "episodes") + SCORER_MARKDOWN,
+                               [[r["config"], r["episodes"]] + [tables.fmt_value(r[m]) for m in SCORER_MARKDOWN]
+                                for r in results], 1)
     atomic_write(os.path.join(out, "configs.csv"), tables.csv_text(("config",) + CONFIG_COLUMNS, rows).encode())
-    atomic_write(os.path.join(out, "configs.md"), f"# {header}\n\n{markdown}\n{tables.SUCCESS_NOTE}\n".encode())
+    atomic_write(os.path.join(out, "configs.md"), f"# {header}\n\n{markdown}\n{SUCCESS_NOTE}\n".encode())
     return ["configs.csv", "configs.md"]
 
 
@@ -208,7 +209,7 @@ def result_of(file: str, spec: dict, state: dict, options) -> dict:
     """The head of evaluation.json: what was scored, and how."""
     return {"kage_evaluation": 1, "checkpoint": file, "agent": spec["agent"], "iteration": state["iteration"],
             "global_step": state["global_step"], "seed": options.seed, "episodes": options.episodes,
-            "metrics": list(METRICS)}
+            "metrics": list(EPISODE_METRICS)}
 
 
 def main(argv: Optional[List[str]] = None) -> int:

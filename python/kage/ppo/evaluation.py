@@ -7,12 +7,12 @@ from typing import Dict, List, Optional
 
 import torch
 
+from kage.fields import ALL, BY_NAME, DIFF_METRICS, LISTED, RECORD, RECORD_COLUMNS
 from kage.ppo.counter_random import CounterRandom
 from kage.ppo.policy import policy_step
 from kage.ppo.wrappers import FrameStack
 
-METRICS = ("x", "y", "vx_mean", "vy_mean", "passed_distance", "progress", "jump_count", "success", "success_once")
-DIFF_METRICS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")  # §3.3
+COLUMN = {name: i for i, name in enumerate(RECORD_COLUMNS)}  # a record's columns by name (kage.fields)
 TRAIN_OFFSET, EVAL_OFFSET, EVAL_OFFSET_STEP = 20_000, 10_000, 1_000  # §3.2
 
 
@@ -49,19 +49,19 @@ class EpisodeMetrics:
 
     def __init__(self, infos: List[dict], dists_to_success: List[float], device):
         self.masks = [torch.from_dlpack(info["_final"]) for info in infos]
-        names = ("return", "length") + METRICS
-        self.fields = {n: [torch.from_dlpack(info["final_info"][n]) for info in infos] for n in names}
+        self.fields = {n: [torch.from_dlpack(info["final_info"][n]) for info in infos] for n in RECORD}
         self.dist_to_success = torch.tensor(dists_to_success, device=device)[:, None]
 
     def mask(self) -> torch.Tensor:
         return torch.stack(self.masks).float()
 
     def rows(self) -> torch.Tensor:
-        """[K, 12, N] float32: finished mask, return, length and the nine metrics of §4.1. QUIRK: success is
-        recomputed with a strict > at the terminal state (the core uses >=)."""
+        """[K, len(RECORD_COLUMNS), N] float32: the finished mask and the recorded fields of §4.1 (kage.fields:
+        the return, the length, then the metrics). QUIRK: success is recomputed with a strict > at the terminal
+        state (the core uses >=)."""
         f = {n: torch.stack(v).float() for n, v in self.fields.items()}
         f["success"] = (f["passed_distance"] > self.dist_to_success).float()
-        return torch.stack([self.mask(), f["return"], f["length"]] + [f[m] for m in METRICS], dim=1)
+        return torch.stack([self.mask()] + [f[n] for n in RECORD], dim=1)
 
 
 @torch.no_grad()
@@ -111,24 +111,24 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
 
 
 def summarize_evaluation(records: torch.Tensor, episodes: int) -> Dict[str, Optional[float]]:
-    """§3.2 steps 3-4 from [steps, 12, N] records: return and length are means over the first `episodes`
-    finished episodes (in step, then environment order) whose return is not exactly 0 (QUIRK: zero
-    returns dropped; all zero gives no value); each metric is its sum over every episode that finished
-    up to the step where the count reached `episodes`, over max(1, that number)."""
-    finished = records[:, 0] > 0                                           # [S, N]
+    """§3.2 steps 3-4 from [steps, len(RECORD_COLUMNS), N] records: the LISTED fields (return and length) are
+    means over the first `episodes` finished episodes (in step, then environment order) whose return is not
+    exactly 0 (QUIRK: zero returns dropped; all zero gives no value); each other metric is its sum over every
+    episode that finished up to the step where the count reached `episodes`, over max(1, that number)."""
+    finished = records[:, COLUMN["finished"]] > 0                          # [S, N]
     per_step = finished.sum(1).cumsum(0)
     last_step = int(torch.nonzero(per_step >= episodes)[0]) if bool((per_step >= episodes).any()) else len(per_step) - 1
-    values = records[: last_step + 1].permute(0, 2, 1)[finished[: last_step + 1]]  # [finished, 12], step-major
+    values = records[: last_step + 1].permute(0, 2, 1)[finished[: last_step + 1]]  # [finished, columns], step-major
     listed = values[:episodes]
-    nonzero = listed[:, 1] != 0
-    result: Dict[str, Optional[float]] = {
-        "episodes": int(values.shape[0]),
-        "return": float(listed[nonzero, 1].mean()) if bool(nonzero.any()) else None,
-        "length": float(listed[nonzero, 2].mean()) if bool(nonzero.any()) else None,
-    }
+    nonzero = listed[:, COLUMN["return"]] != 0
     count = max(1, values.shape[0])
-    for i, m in enumerate(METRICS):
-        result[m] = float(values[:, 3 + i].sum() / count)
+    result: Dict[str, Optional[float]] = {"episodes": int(values.shape[0])}
+    for name in RECORD:
+        if BY_NAME[name].record == LISTED:
+            result[name] = float(listed[nonzero, COLUMN[name]].mean()) if bool(nonzero.any()) else None
+        else:
+            assert BY_NAME[name].record == ALL
+            result[name] = float(values[:, COLUMN[name]].sum() / count)
     return result
 
 

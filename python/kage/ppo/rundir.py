@@ -36,6 +36,7 @@ import torch
 
 from kage import front_end, resources
 from kage.errors import ConfigError
+from kage.fields import SUCCESS_SHOWN
 from kage.ppo import checkpoint, plugins
 from kage.util.files import atomic_write, named_errors, read_json_record, remove_strays, safe, write_json
 from kage.util.lock import DirectoryLock, LockHeld
@@ -474,9 +475,9 @@ class Progress:
                 f"{row['charts/SPS']:,.0f} steps/s  ETA {eta / 60:.1f} min")
         if evaluation is not None:
             train = evaluation["train"]
-            line += f"  | eval return {fmt(train['return'])} success_once {train['success_once']:.2f}"
+            line += f"  | eval return {fmt(train['return'])} {SUCCESS_SHOWN} {train[SUCCESS_SHOWN]:.2f}"
             for label, result in evaluation["evals"].items():
-                line += f"  {label}: {fmt(result['return'])} / {result['success_once']:.2f}"
+                line += f"  {label}: {fmt(result['return'])} / {result[SUCCESS_SHOWN]:.2f}"
         print(line, file=sys.stderr, flush=True)
 
 

@@ -7,12 +7,17 @@ import os
 import sys
 from typing import Dict, Optional
 
-from kage.ppo.evaluation import METRICS
+from kage.fields import BOARD_DIFF, BOARD_SIDE, BY_NAME, DIFF_METRICS, LISTED, RECORD
 
+# The original's copies of two training-row tags, under its own names.
 TRAIN_COPIES = {"train/avg_progress": "main_metrics/avg_train_progress",
                 "train/avg_success_once": "main_metrics/avg_success_once"}
-DIFFS = ("success", "progress", "success_once", "passed_distance", "jump_count")  # besides the return's
-MAIN_DIFFS = ("progress", "success_once", "passed_distance", "jump_count")  # copied under main_metrics/
+
+
+def value_tag(metric: str) -> str:
+    """The original's name of a recorded field at an evaluation: episodic_return and episodic_length for the
+    LISTED ones, config_<metric> for the others."""
+    return f"episodic_{metric}" if BY_NAME[metric].record == LISTED else f"config_{metric}"
 
 
 def number(value: Optional[float]) -> float:
@@ -39,26 +44,22 @@ def eval_scalars(row: dict, train_label: str) -> Dict[str, float]:
         diff = row["diffs"][label]
         tags = {}
         for side, result in (("train", row["train"]), ("eval", evaluated)):
-            tags[f"eval/avg_{side}_episodic_return"] = number(result["return"])
-            tags[f"eval/avg_{side}_episodic_length"] = number(result["length"])
-            tags.update({f"eval/avg_{side}_config_{m}": number(result[m]) for m in METRICS})
-        tags["eval/train_eval_return_diff"] = number(diff["return"])
-        tags.update({f"eval/avg_train_eval_{d}_diff": number(diff[d]) for d in DIFFS})
-        for tag in ("avg_train_episodic_return", "avg_train_config_passed_distance", "avg_train_config_jump_count",
-                    "train_eval_return_diff", *(f"avg_train_eval_{d}_diff" for d in MAIN_DIFFS)):
+            tags.update({f"eval/avg_{side}_{value_tag(m)}": number(result[m]) for m in RECORD})
+        # QUIRK: the return's difference is train_eval_return_diff, every other one's avg_train_eval_<m>_diff.
+        diff_tag = {d: "train_eval_return_diff" if d == "return" else f"avg_train_eval_{d}_diff" for d in DIFF_METRICS}
+        tags.update({f"eval/{diff_tag[d]}": number(diff[d]) for d in DIFF_METRICS})
+        for tag in [f"avg_train_{value_tag(m)}" for m in BOARD_SIDE] + [diff_tag[d] for d in BOARD_DIFF]:
             tags[f"main_metrics/{tag}"] = tags[f"eval/{tag}"]
         return tags
     tags = {}
     for label, result in ((train_label, row["train"]), *evals.items()):
-        tags[f"{label}/avg_episodic_return"] = number(result["return"])
-        tags[f"{label}/avg_episodic_length"] = number(result["length"])
-        tags.update({f"{label}/avg_config_{m}": number(result[m]) for m in METRICS})
-        for tag in ("avg_episodic_return", "avg_config_passed_distance", "avg_config_jump_count"):
-            tags[f"main_metrics/{label}/{tag}"] = tags[f"{label}/{tag}"]
+        tags.update({f"{label}/avg_{value_tag(m)}": number(result[m]) for m in RECORD})
+        for m in BOARD_SIDE:
+            tags[f"main_metrics/{label}/avg_{value_tag(m)}"] = tags[f"{label}/avg_{value_tag(m)}"]
     for label, diff in row["diffs"].items():
-        for d in ("return",) + DIFFS:
+        for d in DIFF_METRICS:
             tags[f"{label}/train_eval_{d}_diff"] = number(diff[d])
-            if d != "success":
+            if d in BOARD_DIFF:
                 tags[f"main_metrics/{label}/train_eval_{d}_diff"] = tags[f"{label}/train_eval_{d}_diff"]
     return tags
 

@@ -46,11 +46,12 @@ from typing import Dict, List, Optional
 import torch
 
 import kage
+from kage.fields import EPISODE_METRICS as METRICS
 from kage.ppo import checkpoint, plugins, rundir, tensorboard_log, video
 from kage.ppo.agent import frames_at
 from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args
 from kage.ppo.counter_random import CounterRandom
-from kage.ppo.evaluation import METRICS, EpisodeMetrics, EvalSettings, EvalTargets, evaluation_rows
+from kage.ppo.evaluation import EpisodeMetrics, EvalSettings, EvalTargets, evaluation_rows
 from kage.ppo.losses import (clip_grad_norm_per_run, compute_gae, drac_regularisers, entropy_coefficient, entropy_of,
                              ppo_loss)
 from kage.ppo.policy import RolloutPolicy, autocast

@@ -12,6 +12,7 @@ import numpy as np
 import torch
 
 import kage
+from kage.fields import VIDEO_METRICS
 from kage.ppo.counter_random import CounterRandom
 from kage.ppo.policy import policy_step
 from kage.ppo.wrappers import FrameStack
@@ -19,7 +20,6 @@ from kage.util.files import atomic_write
 
 FPS = 25  # a GIF counts time in hundredths of a second: 40 ms a frame is exact
 PANEL_WIDTH = 190
-SHOWN = ("return", "x", "passed_distance", "progress", "success_once", "jump_count")  # kage.make_vec's info names
 
 
 def check_path(path: str) -> None:
@@ -66,7 +66,7 @@ def record_frames(agent, run: int, config: str, seed: int, title: str, *, device
             done = bool(host(info["_final"])[0])
             shown, fields = (info["final_obs"], info["final_info"]) if done else (obs, info)
             if step % stride == 0 or done:
-                metrics = {name: float(host(fields[name])[0]) for name in SHOWN}
+                metrics = {name: float(host(fields[name])[0]) for name in VIDEO_METRICS}
                 images.append(annotate(host(shown)[0], title, step, metrics))
             if done:
                 return images, step

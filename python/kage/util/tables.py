@@ -6,11 +6,6 @@ import io
 import math
 from typing import List, Optional, Sequence
 
-SUCCESS_SHOWN = "success_once"
-SUCCESS_NOTE = (f"success is `{SUCCESS_SHOWN}`: the share of episodes that reached the goal at some step, as in "
-                "the paper's success-rate plots; `success` (past the goal at the episode's end) is in the CSV and "
-                "JSON files.")
-
 
 def csv_text(header: Sequence[str], rows: List[list]) -> str:
     out = io.StringIO()
