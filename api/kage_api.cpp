@@ -5,12 +5,14 @@
 
 #include <dlfcn.h>
 
+#include <climits>
 #include <cstring>
 #include <filesystem>
 #include <iterator>
 #include <sstream>
 
 #include "api/environment.h"
+#include "compiler/analysis/mixture.h"
 #include "compiler/codegen/codegen.h"
 #include "compiler/codegen/compiled_dir.h"
 #include "compiler/lower/load_lowered.h"
@@ -125,14 +127,32 @@ std::optional<Loaded> load_yaml(const std::string& path, const Options& options,
   return Loaded{loaded.spec->sha256(), std::move(*loaded.config)};
 }
 
-/// The CPU backend: a HostBatch over generated code (a compiled dir's kernels_host.so) or the generic path.
+/// One config of a CPU batch: its kernels (from `lib`, a compiled dir's kernels_host.so, or the generic path
+/// when null), its assets and its environment count.
+struct HostEnvPart {
+  void* lib = nullptr;
+  std::unique_ptr<HostKernels> kernels;
+  AssetPack pack;
+  int32_t num_envs = 0;
+};
+
+std::vector<HostEnvPart> one_part(void* lib, std::unique_ptr<HostKernels> kernels, AssetPack pack, int32_t num_envs) {
+  std::vector<HostEnvPart> parts;
+  parts.push_back(HostEnvPart{lib, std::move(kernels), std::move(pack), num_envs});
+  return parts;
+}
+
+/// The CPU backend: a HostBatch over generated code (a compiled dir's kernels_host.so) or the generic path,
+/// of one config or of a mixture's (one part each).
 class HostEnv final : public Env {
  public:
+  HostEnv(std::vector<HostEnvPart> parts, int32_t num_threads, std::string hash)
+      : parts_(std::move(parts)), batch_(host_parts(parts_), num_threads), hash_(std::move(hash)) {}
   HostEnv(void* lib, std::unique_ptr<HostKernels> kernels, AssetPack pack, const Options& o, std::string hash)
-      : lib_(lib), pack_(std::move(pack)), batch_(std::move(kernels), pack_.view(), o.num_envs, o.num_threads),
-        hash_(std::move(hash)) {}
+      : HostEnv(one_part(lib, std::move(kernels), std::move(pack), o.num_envs), o.num_threads, std::move(hash)) {}
   ~HostEnv() override {
-    if (lib_) ::dlclose(lib_);
+    for (const HostEnvPart& p : parts_)
+      if (p.lib) ::dlclose(p.lib);
   }
   bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* e) override {
     last_error_kind_ = ErrorKind::kUsage;
@@ -167,6 +187,7 @@ class HostEnv final : public Env {
   const uint8_t* final_mask() const override { return batch_.final_mask(); }
   const uint8_t* final_obs() const override { return batch_.final_observations(); }
   const void* final_info(InfoField f) const override { return info_column(batch_.final_info(), f); }
+  const int32_t* config_index() const override { return batch_.part_index(); }
   bool copy_obs(uint8_t* dst, std::string*) const override {
     std::memcpy(dst, batch_.observations(), batch_.frame_bytes() * static_cast<size_t>(batch_.size()));
     return true;
@@ -183,9 +204,15 @@ class HostEnv final : public Env {
   }
 
  private:
+  /// The batch's parts over `parts`' kernels (moved out) and assets (which stay in `parts`).
+  static std::vector<HostPart> host_parts(std::vector<HostEnvPart>& parts) {
+    std::vector<HostPart> out;
+    for (HostEnvPart& p : parts) out.push_back(HostPart{std::move(p.kernels), p.pack.view(), p.num_envs});
+    return out;
+  }
+
   bool started_ = false;  // a reset or load_state has run
-  void* lib_;
-  AssetPack pack_;
+  std::vector<HostEnvPart> parts_;  // their libraries and assets, which the batch's kernels use
   HostBatch batch_;
   std::string hash_;
   std::vector<int32_t> actions_;
@@ -227,14 +254,18 @@ std::unique_ptr<Env> open_compiled_cpu(const CompiledDir& c, const Options& o, s
 /// GPU over runtime/cuda: a fatbin, or NVRTC on the generated source.
 class GpuEnv final : public Env {
  public:
-  GpuEnv(CUcontext ctx, CudaModule m, DeviceBatch b, AssetPack pack, int32_t H, int32_t W, std::string hash)
+  GpuEnv(CUcontext ctx, CudaModule m, DeviceBatch b, AssetPack pack, int32_t H, int32_t W, std::string hash,
+         CUdeviceptr config_index)
       : ctx_(ctx), module_(std::move(m)), pack_(std::move(pack)), batch_(std::move(b)), H_(H), W_(W),
-        hash_(std::move(hash)) {}
+        hash_(std::move(hash)), config_index_(config_index) {}
   // The members free device memory: in this batch's context, whichever thread drops the last reference,
   // once the device has run all queued work (this batch's launches, and a consumer's kernels on its own
   // stream still reading an output it viewed): cuMemFree alone does not promise to wait.
   ~GpuEnv() override {
-    if (cuCtxSetCurrent(ctx_) == CUDA_SUCCESS) cuCtxSynchronize();
+    if (cuCtxSetCurrent(ctx_) == CUDA_SUCCESS) {
+      cuCtxSynchronize();
+      cuMemFree(config_index_);
+    }
   }
   bool reset(const uint64_t* seeds, const uint8_t* mask, std::string* e) override {
     last_error_kind_ = ErrorKind::kUsage;
@@ -272,6 +303,7 @@ class GpuEnv final : public Env {
   const uint8_t* final_mask() const override { return reinterpret_cast<const uint8_t*>(batch_.final_mask()); }
   const uint8_t* final_obs() const override { return reinterpret_cast<const uint8_t*>(batch_.final_obs()); }
   const void* final_info(InfoField f) const override { return info_column(batch_.final_info(), f); }
+  const int32_t* config_index() const override { return reinterpret_cast<const int32_t*>(config_index_); }
   bool copy_obs(uint8_t* dst, std::string* e) const override { return bind(e) && batch_.download_obs(dst, e); }
   bool synchronize(std::string* e) override {
     last_error_kind_ = ErrorKind::kOther;
@@ -317,6 +349,7 @@ class GpuEnv final : public Env {
   DeviceBatch batch_;
   int32_t H_, W_;
   std::string hash_;
+  CUdeviceptr config_index_;  ///< [N] int32 zeros: one config
   std::vector<int32_t> actions_;
 };
 
@@ -337,8 +370,16 @@ std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const 
   auto b = DeviceBatch::create(*m, l.config.latent, l.config.visual, pack.view(), o.num_envs, error);
   if (!b) return nullptr;
   b->set_stream(static_cast<CUstream>(o.stream));
+  const size_t index_bytes = static_cast<size_t>(o.num_envs) * sizeof(int32_t);
+  CUdeviceptr config_index = 0;
+  CUresult r = cuMemAlloc(&config_index, index_bytes);
+  if (r == CUDA_SUCCESS) r = cuMemsetD8(config_index, 0, index_bytes);
+  if (r != CUDA_SUCCESS) {
+    if (config_index) cuMemFree(config_index);
+    return fail(error, cu_error_text(r, "cuMemAlloc(config index)")), nullptr;
+  }
   return std::make_unique<GpuEnv>(ctx, std::move(*m), std::move(*b), std::move(pack), l.config.visual.H, l.config.visual.W,
-                                  l.spec_hash);
+                                  l.spec_hash, config_index);
 }
 #endif
 
@@ -405,7 +446,78 @@ std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::st
 #endif
 }
 
+/// open_mixture() without the final error kind (see open_any).
+std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, const Options& o, std::string* error,
+                                      ErrorKind* kind) {
+  *kind = ErrorKind::kUsage;
+  int64_t total = 0;
+  for (const MixturePart& p : parts) {
+    if (p.num_envs < 0) return fail(error, "kage::open_mixture: a part with " + std::to_string(p.num_envs) +
+                                               " environments"), nullptr;
+    total += p.num_envs;
+  }
+  if (parts.empty() || total <= 0 || total > INT32_MAX || o.num_threads <= 0)
+    return fail(error, "kage::open_mixture: give one or more parts with 1 to 2^31 - 1 environments in all, and a "
+                       "positive thread count"), nullptr;
+  if (o.backend != Backend::kCpu)
+    return fail(error, "kage::open_mixture: a mixture runs on the CPU backend for now"), nullptr;
+  std::error_code ec;
+  for (const MixturePart& p : parts)
+    if (fs::is_directory(p.path, ec))
+      return fail(error, "kage::open_mixture: '" + p.path + "' is a kagec compile directory: a mixture is certified "
+                         "from its configs' YAML, so give the YAML configs it was compiled from"), nullptr;
+  // kagec's certificate first: nothing is lowered, loaded or allocated for configs that do not certify.
+  *kind = ErrorKind::kConfig;
+  SourceManager sources;
+  DiagEngine diags(sources);
+  DiskFileReader reader;
+  ResolveOptions ro;
+  if (!o.asset_root.empty()) ro.asset_root = o.asset_root;
+  std::vector<std::string> paths;
+  for (const MixturePart& p : parts) paths.push_back(p.path);
+  const std::optional<std::vector<Spec>> specs = analyze_mixture(paths, ro, sources, reader, diags);
+  if (!specs) {
+    std::ostringstream s;
+    print_text(diags, s);
+    return fail(error, s.str() + "kage::open_mixture: not a mixture of these configs"), nullptr;
+  }
+  std::vector<LoweredConfig> lowered;
+  std::vector<std::pair<std::string, int32_t>> identity;
+  for (size_t k = 0; k < parts.size(); ++k) {
+    LowerResult l = lower_spec((*specs)[k]);
+    if (!l.ok()) return fail(error, l.error_text()), nullptr;
+    lowered.push_back(std::move(*l.config));
+    identity.emplace_back((*specs)[k].sha256(), parts[k].num_envs);
+  }
+  *kind = ErrorKind::kUsage;
+  for (const LoweredConfig& c : lowered)  // the environments take the same memory in every part but the scratch
+    if (!fits_in_memory(c.latent, c.visual, Options{o.backend, static_cast<int32_t>(total), o.num_threads}, error))
+      return nullptr;
+  *kind = ErrorKind::kOther;
+  std::vector<HostEnvPart> host;
+  for (size_t k = 0; k < parts.size(); ++k) {
+    AssetPackResult assets = load_asset_pack(lowered[k].assets);
+    if (!assets.ok()) return fail(error, "kage::open_mixture: " + assets.error), nullptr;
+    host.push_back(HostEnvPart{nullptr, generic_host_kernels(lowered[k].latent, lowered[k].visual),
+                               std::move(*assets.pack), parts[k].num_envs});
+  }
+  std::vector<const HostKernels*> kernels;
+  for (const HostEnvPart& h : host) kernels.push_back(h.kernels.get());
+  const std::string problem = HostBatch::parts_problem(kernels);
+  if (!problem.empty()) return fail(error, "kage::open_mixture: internal: a certified mixture whose " + problem), nullptr;
+  return std::make_unique<HostEnv>(std::move(host), o.num_threads, mixture_sha256(identity));
+}
+
 }  // namespace
+
+std::unique_ptr<Env> open_mixture(const std::vector<MixturePart>& parts, const Options& o, std::string* error,
+                                  ErrorKind* kind_out) {
+  ErrorKind ignored = ErrorKind::kOther;
+  ErrorKind* kind = kind_out ? kind_out : &ignored;
+  std::unique_ptr<Env> env = open_mixture_any(parts, o, error, kind);
+  if (env) *kind = ErrorKind::kNone;
+  return env;
+}
 
 const char* action_range_text() { return "an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump)"; }
 

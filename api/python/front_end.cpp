@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "compiler/analysis/diff.h"
+#include "compiler/analysis/mixture.h"
 #include "compiler/analysis/suite.h"
 #include "compiler/basic/file_out.h"
 
@@ -44,6 +45,17 @@ FrontEndResult certify_pair_json(const std::string& train, const std::string& ev
   const Certification cert = certify(diff, std::nullopt, {});
   return {json_file_text(certificate_json({train, t->sha256()}, {eval, e->sha256()}, diff, cert)), ""};
 }
+
+FrontEndResult certify_mixture_json(const std::vector<std::string>& paths, const std::string& asset_root) {
+  SourceManager sources;
+  DiagEngine diags(sources);
+  DiskFileReader reader;
+  const auto specs = analyze_mixture(paths, options_for(asset_root), sources, reader, diags);
+  if (!specs) return {"", diagnostics_text(diags) + "kage: not a mixture of these configs"};
+  return {json_file_text(mixture_json(paths, *specs, config_schema())), ""};
+}
+
+std::string mixture_hash(const std::vector<std::pair<std::string, int32_t>>& parts) { return mixture_sha256(parts); }
 
 FrontEndResult suite_report(const std::string& manifest) {
   SourceManager sources;

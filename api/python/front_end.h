@@ -1,8 +1,11 @@
-// The config compiler's front end for the Python package: resolve a config, certify a pair, check a
-// suite. Errors come back as kagec's diagnostics text.
+// The config compiler's front end for the Python package: resolve a config, certify a pair or a mixture,
+// check a suite. Errors come back as kagec's diagnostics text.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace kage::python {
 
@@ -17,6 +20,11 @@ struct FrontEndResult {
 FrontEndResult resolve_config_json(const std::string& path, const std::string& asset_root);
 /// The certificate of a train/eval pair (kagec diff --certify -o), verdict included.
 FrontEndResult certify_pair_json(const std::string& train, const std::string& eval, const std::string& asset_root);
+/// The certificate of a mixture (kagec diff --mixture -o): its configs, their Spec hashes and the visual axes
+/// they differ on; kagec's diagnostics when a config has errors or the configs differ on a latent key.
+FrontEndResult certify_mixture_json(const std::vector<std::string>& paths, const std::string& asset_root);
+/// The spec hash of a mixture batch (kage::open_mixture's): of its parts' Spec hashes and environment counts.
+std::string mixture_hash(const std::vector<std::pair<std::string, int32_t>>& parts);
 /// The report of a suite manifest (kagec suite's report.json): every pair's paths, axis, sweep and
 /// certificate.
 FrontEndResult suite_report(const std::string& manifest);

@@ -391,6 +391,9 @@ class PyEnv {
       // Bool, as Gymnasium's flags and masks are: a uint8 0/1 mask would index rows 0 and 1 instead of masking.
       l.dtype = kage::DType::kBool;
       l.data = name == "terminated" ? env.terminated() : name == "truncated" ? env.truncated() : env.final_mask();
+    } else if (name == "info/config" || name == "final_info/config") {
+      l.data = env.config_index();  // constant: a finished episode ran the same config
+      l.dtype = kage::DType::kInt32;
     } else {
       const bool final = name.rfind("final_info/", 0) == 0;
       const std::string field = name.substr(name.find('/') + 1);
@@ -464,20 +467,15 @@ class PyEnv {
   std::shared_ptr<std::mutex> mutex_;  // shared: PyEnv is moved once, out of open_env
 };
 
-PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& device, int32_t num_threads,
-               const std::string& asset_root, uintptr_t stream) {
-  kage::Options o;
-  o.backend = device == "cuda" ? kage::Backend::kGpu : kage::Backend::kCpu;
-  o.num_envs = num_envs;
-  o.num_threads = num_threads;
-  o.asset_root = asset_root;
-  o.stream = reinterpret_cast<void*>(stream);
+/// The batch `open_fn(error, kind)` opens (without the GIL), or its failure raised as the class of its kind.
+template <class Open>
+PyEnv opened(const Open& open_fn) {
   std::string error;
   kage::ErrorKind kind = kage::ErrorKind::kOther;
   std::unique_ptr<kage::Env> env;
   {
     py::gil_scoped_release release;
-    env = kage::open(path, o, &error, &kind);
+    env = open_fn(&error, &kind);
   }
   if (env) return PyEnv(std::shared_ptr<kage::Env>(std::move(env)));
   const ErrorClasses& e = error_classes();
@@ -488,6 +486,28 @@ PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& dev
                                                              : e.other;
   PyErr_SetObject(cls.ptr(), text(error).ptr());
   throw py::error_already_set();
+}
+
+PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& device, int32_t num_threads,
+               const std::string& asset_root, uintptr_t stream) {
+  kage::Options o;
+  o.backend = device == "cuda" ? kage::Backend::kGpu : kage::Backend::kCpu;
+  o.num_envs = num_envs;
+  o.num_threads = num_threads;
+  o.asset_root = asset_root;
+  o.stream = reinterpret_cast<void*>(stream);
+  return opened([&](std::string* error, kage::ErrorKind* kind) { return kage::open(path, o, error, kind); });
+}
+
+PyEnv open_mixture(const std::vector<std::string>& paths, const std::vector<int32_t>& counts, int32_t num_threads,
+                   const std::string& asset_root) {
+  if (paths.size() != counts.size()) raise_value_error("open_mixture: one environment count per config");
+  std::vector<kage::MixturePart> parts;
+  for (size_t k = 0; k < paths.size(); ++k) parts.push_back(kage::MixturePart{paths[k], counts[k]});
+  kage::Options o;
+  o.num_threads = num_threads;
+  o.asset_root = asset_root;
+  return opened([&](std::string* error, kage::ErrorKind* kind) { return kage::open_mixture(parts, o, error, kind); });
 }
 
 /// The JSON of a front-end call, or its diagnostics raised as the config error class.
@@ -532,6 +552,15 @@ PYBIND11_MODULE(_kage, m) {
     return front_end_json(kage::python::certify_pair_json(train, eval, asset_root));
   }, py::arg("train"), py::arg("eval"), py::arg("asset_root") = "",
      "kagec diff --certify: the pair's certificate as JSON text.");
+  m.def("certify_mixture", [](const std::vector<std::string>& paths, const std::string& asset_root) {
+    return front_end_json(kage::python::certify_mixture_json(paths, asset_root));
+  }, py::arg("paths"), py::arg("asset_root") = "", "kagec diff --mixture: the mixture's certificate as JSON text.");
+  m.def("mixture_hash", [](const std::vector<std::string>& hashes, const std::vector<int32_t>& counts) {
+    if (hashes.size() != counts.size()) raise_value_error("mixture_hash: one environment count per Spec hash");
+    std::vector<std::pair<std::string, int32_t>> parts;
+    for (size_t k = 0; k < hashes.size(); ++k) parts.emplace_back(hashes[k], counts[k]);
+    return kage::python::mixture_hash(parts);
+  }, py::arg("spec_hashes"), py::arg("counts"), "The spec hash of a mixture batch of these parts.");
   m.def("suite_report", [](const std::string& manifest) {
     return front_end_json(kage::python::suite_report(manifest));
   }, py::arg("manifest"), "kagec suite: the report of a manifest (pairs, sweeps, certificates) as JSON text.");
@@ -544,6 +573,8 @@ PYBIND11_MODULE(_kage, m) {
   }, "(name, numpy dtype, meaning) of every info field, in order.");
   m.def("open", &open_env, py::arg("path"), py::arg("num_envs"), py::arg("device"), py::arg("num_threads"),
         py::arg("asset_root"), py::arg("stream"));
+  m.def("open_mixture", &open_mixture, py::arg("paths"), py::arg("counts"), py::arg("num_threads"),
+        py::arg("asset_root"));
 
   py::class_<DeviceArray>(m, "DeviceArray",
                           "A [N, ...] array in GPU memory, owned by an environment: take it with "

@@ -191,6 +191,9 @@ class SchemaLoader {
       k.absent_section_scale = prop.at("x-kage-absent-section-default").value("scale", 1.0);
     }
     k.asset_kind = prop.value("x-kage-asset", "");
+    k.observation = prop.value("x-kage-observation", "");
+    KAGE_INTERNAL_ASSERT(k.observation.empty() || k.observation == "height" || k.observation == "width",
+                         "schema key " + k.path + ": x-kage-observation is height or width");
     if (prop.contains("x-kage-inert-when")) k.inert_when = prop.at("x-kage-inert-when");
     if (prop.contains("x-kage-quirk")) {
       k.quirk_rule = prop.at("x-kage-quirk").at("rule").get<std::string>();

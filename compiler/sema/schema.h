@@ -68,6 +68,7 @@ struct KeySchema {
   std::string alias_of;  // legacy key: the modern key's name
   std::string absent_section_of;  // root key this default scales when the section is absent
   double absent_section_scale = 1;
+  std::string observation;  // "height" or "width": a side of the observation image (x-kage-observation), else empty
   std::string asset_kind;  // file, dir, file_list, dir_list, skin_parent, image_dir
   Json inert_when;         // list of condition objects, or null
   std::string quirk_rule, quirk_message;

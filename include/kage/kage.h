@@ -140,6 +140,9 @@ class Env {
   virtual const uint8_t* final_obs() const = 0;
   /// [N] values of one info field of the finished episode's last step, where final_mask is 1.
   virtual const void* final_info(InfoField field) const = 0;
+  /// [N] int32, the same for the life of the batch: the index of the config each environment runs (0 for
+  /// every environment of a batch of one config). Python's info["config"].
+  virtual const int32_t* config_index() const = 0;
 
   /// Copies the observations of the last reset or step (num_envs() * height() * width() * 3 bytes)
   /// into host memory `dst`, on either backend.
@@ -170,6 +173,22 @@ class Env {
 /// with the message in `error` and its kind in `kind` (if given).
 std::unique_ptr<Env> open(const std::string& path, const Options& options, std::string* error,
                           ErrorKind* kind = nullptr);
+
+/// One config of a mixture (open_mixture) and how many environments run it.
+struct MixturePart {
+  std::string path;      ///< a YAML config
+  int32_t num_envs = 0;  ///< >= 0
+};
+
+/// Opens one batch whose environments run several configs: part k's num_envs environments, numbered after
+/// the earlier parts' (config_index() gives each environment's part). The configs must differ only on visual
+/// axes: one hidden game (every latent key equal) and one observation shape, which kagec certifies first (its
+/// located diagnostics, kind kConfig, before anything is loaded). Each part runs its own kernels and writes its
+/// rows of the one set of outputs, so environment i equals environment i of its config run alone with the same
+/// seed and actions. options.num_envs is ignored (the batch has the parts' sum); CPU backend only (kUsage on
+/// the GPU). The spec hash is a mixture's (the configs' Spec hashes and counts: kagec diff --mixture).
+std::unique_ptr<Env> open_mixture(const std::vector<MixturePart>& parts, const Options& options, std::string* error,
+                                  ErrorKind* kind = nullptr);
 
 /// Whether this build can run the GPU backend (the CUDA runtime pieces were compiled in).
 bool gpu_backend_built();

@@ -1,9 +1,10 @@
-"""kagec's front end from Python: a config resolved to its Spec, a train/eval pair certified, a suite's
-report. Each returns the JSON that ``kagec resolve``, ``kagec diff --certify`` and ``kagec suite`` print,
-parsed, and raises ``kage.ConfigError`` with kagec's located diagnostics when the input has errors."""
+"""kagec's front end from Python: a config resolved to its Spec, a train/eval pair certified, a mixture
+certified, a suite's report. Each returns the JSON that ``kagec resolve``, ``kagec diff --certify``, ``kagec diff
+--mixture`` and ``kagec suite`` print, parsed, and raises ``kage.ConfigError`` with kagec's located diagnostics
+when the input has errors."""
 import json
 import os
-from typing import Optional, Union
+from typing import Optional, Sequence, Union
 
 from kage._native import native
 
@@ -18,6 +19,19 @@ def resolve(config: Path, asset_root: Optional[str] = None) -> dict:
 def certify(train: Path, eval: Path, asset_root: Optional[str] = None) -> dict:
     """The isolation certificate of a train/eval pair (``kagec diff --certify``)."""
     return json.loads(native().certify(os.fspath(train), os.fspath(eval), asset_root or ""))
+
+
+def certify_mixture(configs: Sequence[Path], asset_root: Optional[str] = None) -> dict:
+    """The certificate of a mixture (``kagec diff --mixture``): ``{"certified": true, "configs": [{"name",
+    "spec_sha256"}, ...], "axes": [...]}``. Raises ``kage.ConfigError`` when a config has errors, or when the
+    configs differ on a latent key or in observation shape (one located error naming the first such key and
+    both files)."""
+    return json.loads(native().certify_mixture([os.fspath(c) for c in configs], asset_root or ""))
+
+
+def mixture_hash(spec_hashes: Sequence[str], counts: Sequence[int]) -> str:
+    """The spec hash of a mixture batch: of its configs' Spec hashes and environment counts, in order."""
+    return native().mixture_hash(list(spec_hashes), [int(c) for c in counts])
 
 
 def suite_report(manifest: Path) -> dict:

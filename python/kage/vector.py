@@ -8,15 +8,20 @@ copy what you keep (``obs.copy()``, ``tensor.clone()``).
 import contextlib
 import os
 import threading
-from typing import Any, Dict, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from kage import actions as _actions, front_end, resources, spaces
+from kage import actions as _actions, fields, front_end, mixture as _mixture, resources, spaces
 from kage._native import native
 
-#: (name, numpy dtype, meaning) of every info field, in the runtime's order.
+#: (name, numpy dtype, meaning) of every info field the runtime writes, in its order (runtime/info_fields.def).
 INFO_FIELDS = tuple(native().info_fields())
+_problem = fields.runtime_problem([name for name, _, _ in INFO_FIELDS])
+if _problem:
+    raise ImportError(f"kage: {_problem}")
+#: The names of info's per-environment arrays: the runtime's fields, then the batch's (kage.fields.BATCH_FIELDS).
+INFO_NAMES = tuple(name for name, _, _ in INFO_FIELDS) + fields.BATCH_FIELDS
 
 Seed = Union[int, Sequence[int], None]
 
@@ -82,13 +87,15 @@ def _state_bytes(state) -> Any:
 
 
 class VecEnv:
-    """``num_envs`` environments of one configuration, stepped together.
+    """``num_envs`` environments of one configuration (or of a mixture: ``make_vec``), stepped together.
 
     ``reset(seed=None, options=None) -> (obs, info)`` and
     ``step(actions) -> (obs, reward, terminated, truncated, info)``: obs uint8 [N, H, W, 3], reward
     float32 [N], terminated and truncated bool [N], info a dict of [N] arrays named as the original's
     info (``x``, ``y``, ``vx``, ``vy``, ``vx_mean``, ``vy_mean``, ``timestep``, ``passed_distance``,
-    ``progress``, ``success``, ``success_once``, ``jump_count``, ``return``, ``length``).
+    ``progress``, ``success``, ``success_once``, ``jump_count``, ``return``, ``length``), and ``config``
+    (int32: the index of the config each environment runs; 0 for a batch of one config). kage.fields
+    lists them (``INFO_NAMES``).
 
     Same-step autoreset: when a step ends an episode, that environment starts its next episode in the
     same step. The step returns the finishing step's reward and flags, the new episode's first
@@ -114,14 +121,19 @@ class VecEnv:
     spec = None  # Gymnasium's EnvSpec, where gymnasium.make_vec made the batch
     render_mode = None
 
-    def __init__(self, handle: "kage._kage.Env", config: str, seed: int, asset_root: Optional[str] = None):
+    def __init__(self, handle: "kage._kage.Env", config: Union[str, List[str]], seed: int,
+                 asset_root: Optional[str] = None, counts: Optional[Sequence[int]] = None):
         self._handle = handle
         self._lock = threading.Lock()  # one call at a time (see Threads above)
         self._caller: Optional[int] = None  # the thread inside a call, which a re-entrant call must not wait for
-        self.config = config
+        self.config = config  # as make_vec was given it: a path, or a mixture's list of paths
+        self.configs: Tuple[str, ...] = (config,) if isinstance(config, str) else tuple(config)
         self._asset_root = asset_root
         self._spec: Optional[dict] = None
+        self._specs: Optional[List[dict]] = None
         self.num_envs = handle.num_envs
+        #: How many environments run each config (config 0's first: info["config"]).
+        self.counts: Tuple[int, ...] = (self.num_envs,) if counts is None else tuple(int(c) for c in counts)
         self.device = handle.device
         self.spec_hash = handle.spec_hash
         self.single_observation_space = spaces.observation_space(handle.height, handle.width)
@@ -134,9 +146,9 @@ class VecEnv:
         self._reward = out("reward")
         self._terminated = out("terminated")
         self._truncated = out("truncated")
-        self._info = {name: out(f"info/{name}") for name, _, _ in INFO_FIELDS}
+        self._info = {name: out(f"info/{name}") for name in INFO_NAMES}
         final_mask = out("final_mask")
-        final_info = {name: out(f"final_info/{name}") for name, _, _ in INFO_FIELDS}
+        final_info = {name: out(f"final_info/{name}") for name in INFO_NAMES}
         # Gymnasium 1.x same-step keys; _final_obs and _final_info are the same mask as _final.
         self._final = {
             "final_obs": out("final_obs"),
@@ -246,7 +258,11 @@ class VecEnv:
     def resolved_spec(self) -> dict:
         """The resolved Spec the batch runs, as ``kagec resolve`` prints it (``{"config": {...}, "sha256": ...}``;
         Gymnasium's ``spec`` is another thing, an EnvSpec). Resolved on first use and checked against the
-        batch's ``spec_hash``: a config file edited since ``make_vec`` raises instead of describing another game."""
+        batch's ``spec_hash``: a config file edited since ``make_vec`` raises instead of describing another game.
+        A mixture runs several: see ``resolved_specs``."""
+        if not isinstance(self.config, str):
+            raise ValueError(f"this batch is a mixture of {len(self.configs)} configs, each with its own Spec: "
+                             "resolved_specs lists them")
         if self._spec is None:
             if os.path.isdir(self.config):
                 raise ValueError(f"{self.config} is a kagec compile directory, which holds no Spec: resolve the YAML "
@@ -257,6 +273,22 @@ class VecEnv:
                                    f"{self.spec_hash[:12]} then, {spec['sha256'][:12]} now): make the environment again")
             self._spec = spec
         return self._spec
+
+    @property
+    def resolved_specs(self) -> List[dict]:
+        """The resolved Spec of each config, in order (one for a batch of one config), checked as
+        ``resolved_spec`` is: a mixture's ``spec_hash`` is that of its configs' Specs and counts
+        (``kage.front_end.mixture_hash``)."""
+        if isinstance(self.config, str):
+            return [self.resolved_spec]
+        if self._specs is None:
+            specs = [front_end.resolve(c, self._asset_root) for c in self.configs]
+            now = front_end.mixture_hash([s["sha256"] for s in specs], self.counts)
+            if now != self.spec_hash:
+                raise RuntimeError(f"a config of this mixture changed since it was made (mixture {self.spec_hash[:12]} "
+                                   f"then, {now[:12]} now): make the environment again")
+            self._specs = specs
+        return self._specs
 
     @property
     def closed(self) -> bool:
@@ -291,10 +323,21 @@ class VecEnv:
         return info
 
 
-def make_vec(config: Union[str, os.PathLike], num_envs: int, device: str = "cpu", seed: int = 0,
-             asset_root: Optional[str] = None, threads: Optional[int] = None, stream=None) -> VecEnv:
+def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]], num_envs: int, device: str = "cpu",
+             seed: int = 0, asset_root: Optional[str] = None, threads: Optional[int] = None, stream=None,
+             weights: Optional[Sequence[float]] = None) -> VecEnv:
     """A batch of ``num_envs`` environments of ``config`` (a YAML file or a ``kagec compile``
     directory) on ``device`` ("cpu" or "cuda").
+
+    A list of YAML configs makes a mixture: one batch whose environments are split across the configs by
+    ``weights`` (one non-negative number per config; default equal), each config's environments running its
+    own kernels and writing their part of the one set of outputs; ``info["config"]`` gives each environment's
+    config index (``kage.mixture`` says exactly how the batch is split). The configs must differ only on
+    visual axes: one hidden game (physics, layout geometry, reward, episode length) and one observation shape,
+    which kagec certifies first (a config that differs raises ``kage.ConfigError`` naming the first latent key,
+    located, and both files). Environment i gets the seed it would get in a batch of one config
+    (``env_seeds(seed, num_envs)[i]``), so each config's slice equals that config run alone with those
+    seeds. A mixture runs on the CPU.
 
     ``seed`` seeds ``reset()`` calls without a seed. ``asset_root`` resolves the config's asset paths
     (default: relative to the file that names them). ``threads``: CPU worker threads (default: one
@@ -306,22 +349,31 @@ def make_vec(config: Union[str, os.PathLike], num_envs: int, device: str = "cpu"
     ``FileNotFoundError`` for a missing config, ``RuntimeError`` for ``device="cuda"`` without a usable
     GPU, ``ValueError`` for bad arguments and for a CPU batch that would need more than half of the
     machine's memory. The batch holds no episode until the first ``reset()`` (or ``load_state``): a step
-    before it raises ``RuntimeError``.
+    before it raises ``RuntimeError``. Every argument is checked before anything is made.
     """
-    if not isinstance(config, (str, bytes, os.PathLike)):
+    mixture = not isinstance(config, (str, bytes, os.PathLike))
+    if mixture and not isinstance(config, (list, tuple)):
         raise TypeError(f"config={config!r:.80}: a path (str or os.PathLike) to a YAML config or a kagec compile "
-                        "directory, or a shipped config's name")
-    config = os.fspath(config)
+                        "directory, or a shipped config's name; or a list of YAML configs (a mixture)")
+    if weights is not None and not mixture:
+        raise ValueError("weights= splits a mixture: give a list of configs")
+    configs = _mixture.config_list(config) if mixture else [os.fspath(config)]
     if device not in ("cpu", "cuda"):
         raise ValueError(f"device={device!r}: use 'cpu' or 'cuda'")
     if not _is_integer(num_envs) or not 0 < num_envs <= MAX_INT32:
         raise ValueError(f"num_envs={num_envs!r}: a positive integer up to {MAX_INT32}")
+    counts = _mixture.split(int(num_envs), _mixture.weights_of(weights, len(configs))) if mixture else None
+    if mixture and device != "cpu":
+        raise ValueError(f"device={device!r}: a mixture runs on the CPU for now (device='cpu')")
     seed = _seed_value(seed)
     if asset_root is not None:
         if not isinstance(asset_root, (str, bytes, os.PathLike)):
             raise ValueError(f"asset_root={asset_root!r:.80}: a directory path (str or os.PathLike)")
         asset_root = os.fsdecode(asset_root)
-    config = resources.config_path(config)  # a path, or a shipped config's name; FileNotFoundError names near ones
+    # Paths, or shipped configs' names; FileNotFoundError names near ones.
+    configs = [resources.config_path(c) for c in configs]
+    if mixture:
+        configs = _mixture.yaml_configs(configs)
     if threads is None:
         threads = min(int(num_envs), os.cpu_count() or 1)
     if not _is_integer(threads) or not 0 < threads <= MAX_INT32:
@@ -331,5 +383,10 @@ def make_vec(config: Union[str, os.PathLike], num_envs: int, device: str = "cpu"
     stream_handle = 0 if stream is None else getattr(stream, "cuda_stream", stream)
     if not _is_integer(stream_handle) or not 0 <= stream_handle < 2**64:
         raise ValueError(f"stream={stream!r}: a torch.cuda.Stream or a CUstream handle (an integer)")
-    handle = native().open(config, int(num_envs), device, int(threads), asset_root or "", int(stream_handle))
-    return VecEnv(handle, config, seed, asset_root)
+    if mixture:
+        # kagec's certificate first: a refusal (ConfigError, one located line) before anything is made.
+        front_end.certify_mixture(configs, asset_root)
+        handle = native().open_mixture(configs, list(counts), int(threads), asset_root or "")
+    else:
+        handle = native().open(configs[0], int(num_envs), device, int(threads), asset_root or "", int(stream_handle))
+    return VecEnv(handle, configs if mixture else configs[0], seed, asset_root, counts)

@@ -59,15 +59,31 @@ std::unique_ptr<HostKernels> generated_host_kernels(const HostEntryPoints& entry
   return std::make_unique<GeneratedHostKernels>(entry_points);
 }
 
+namespace {
+
+std::vector<HostPart> one_part(std::unique_ptr<HostKernels> kernels, const AssetView& assets, int32_t num_envs) {
+  std::vector<HostPart> parts;
+  parts.push_back(HostPart{std::move(kernels), assets, num_envs});
+  return parts;
+}
+
+size_t frame_bytes_of(const HostKernels& k) { return static_cast<size_t>(k.visual().H) * k.visual().W * 3; }
+
+}  // namespace
+
 HostBatch::HostBatch(std::unique_ptr<HostKernels> kernels, const AssetView& assets, int32_t num_envs,
                      int32_t num_threads, bool info_shows_new_episode)
-    : kernels_(std::move(kernels)),
-      assets_(assets),
-      n_(num_envs),
+    : HostBatch(one_part(std::move(kernels), assets, num_envs), num_threads, info_shows_new_episode) {}
+
+HostBatch::HostBatch(std::vector<HostPart> parts, int32_t num_threads, bool info_shows_new_episode)
+    : parts_(std::move(parts)),
+      n_(0),
       threads_(std::max(1, num_threads)),
       info_shows_new_episode_(info_shows_new_episode) {
-  seg_bytes_ = static_cast<size_t>(layout_segment_count(kernels_->latent()));
-  frame_ = static_cast<size_t>(kernels_->visual().H) * kernels_->visual().W * 3;
+  for (size_t k = 0; k < parts_.size(); ++k) part_.insert(part_.end(), parts_[k].num_envs, static_cast<int32_t>(k));
+  n_ = static_cast<int32_t>(part_.size());
+  seg_bytes_ = static_cast<size_t>(layout_segment_count(latent_params()));
+  frame_ = frame_bytes_of(*parts_.front().kernels);
   const size_t n = static_cast<size_t>(n_);
   seeds_.assign(n, 0);
   latent_.assign(n, LatentState{});
@@ -80,10 +96,26 @@ HostBatch::HostBatch(std::unique_ptr<HostKernels> kernels, const AssetView& asse
   final_info_.resize(n);
 }
 
+std::string HostBatch::parts_problem(const std::vector<const HostKernels*>& kernels) {
+  for (size_t k = 1; k < kernels.size(); ++k) {
+    const HostKernels& first = *kernels.front();
+    const HostKernels& other = *kernels[k];
+    if (frame_bytes_of(other) != frame_bytes_of(first))
+      return "part " + std::to_string(k) + " renders " + std::to_string(other.visual().H) + "x" +
+             std::to_string(other.visual().W) + " frames, part 0 " + std::to_string(first.visual().H) + "x" +
+             std::to_string(first.visual().W);
+    if (layout_segment_count(other.latent()) != layout_segment_count(first.latent()))
+      return "part " + std::to_string(k) + "'s layout has another size than part 0's";
+  }
+  return {};
+}
+
 template <class Fn>
 void HostBatch::parallel_for(const Fn& fn) {
   const int32_t threads = std::min(threads_, n_);
-  const size_t scratch_floats = static_cast<size_t>(render_scratch_floats(kernels_->visual()));
+  size_t scratch_floats = 0;
+  for (const HostPart& p : parts_)
+    scratch_floats = std::max(scratch_floats, static_cast<size_t>(render_scratch_floats(p.kernels->visual())));
   if (scratch_.size() < scratch_floats * threads) scratch_.resize(scratch_floats * threads);
   auto range = [&](int32_t i) {
     float* scratch = scratch_.data() + scratch_floats * i;
@@ -98,7 +130,8 @@ void HostBatch::parallel_for(const Fn& fn) {
 }
 
 void HostBatch::reset_env(int32_t env, uint32_t episode, float* scratch) {
-  kernels_->reset_env(assets_, fold(seed_key(seeds_[env]), episode), episode, slot(env, scratch));
+  const HostPart& p = part(env);
+  p.kernels->reset_env(p.assets, fold(seed_key(seeds_[env]), episode), episode, slot(env, scratch));
 }
 
 void HostBatch::reset(const uint64_t* seeds, const uint8_t* mask) {
@@ -118,7 +151,8 @@ void HostBatch::step(const int32_t* actions) {
     StepRows row = rows;
     row.env = env;
     row.final_obs = final_obs_.data() + env * frame_;
-    kernels_->step_env(assets_, seed_key(seeds_[env]), actions[env], slot(env, scratch), row);
+    const HostPart& p = part(env);
+    p.kernels->step_env(p.assets, seed_key(seeds_[env]), actions[env], slot(env, scratch), row);
   });
 }
 
@@ -162,7 +196,8 @@ std::string HostBatch::load_state(const uint8_t* data, size_t size, const std::s
   // Frames are a pure function of the state: render them again instead of saving them.
   parallel_for([&](int32_t env, float* scratch) {
     final_mask_[env] = 0;
-    kernels_->render_env(assets_, episode_key(env), slot(env, scratch));
+    const HostPart& p = part(env);
+    p.kernels->render_env(p.assets, episode_key(env), slot(env, scratch));
   });
   return {};
 }

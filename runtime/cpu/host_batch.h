@@ -1,6 +1,7 @@
-// The CPU batch of the public API: N environments of one configuration stepped through a
-// HostKernels (a generated kernels_host.so, or the generic path over run-time parameters) and split over
-// threads, with same-step automatic reset that keeps the finished episode's final frame and info.
+// The CPU batch of the public API: N environments of one configuration (or of several: a mixture, each
+// config's environments a part) stepped through a HostKernels (a generated kernels_host.so, or the generic
+// path over run-time parameters) and split over threads, with same-step automatic reset that keeps the
+// finished episode's final frame and info.
 #pragma once
 
 #include <cstdint>
@@ -34,6 +35,14 @@ std::unique_ptr<HostKernels> generic_host_kernels(const LatentParams& latent, co
 /// A generated library's entry points (every one non-null, ABI checked by the caller).
 std::unique_ptr<HostKernels> generated_host_kernels(const HostEntryPoints& entry_points);
 
+/// The environments of one config in a batch. A batch over several (a mixture) numbers them part by part:
+/// the first part's environments first.
+struct HostPart {
+  std::unique_ptr<HostKernels> kernels;
+  AssetView assets;  ///< must outlive the batch
+  int32_t num_envs = 0;
+};
+
 class HostBatch {
  public:
   /// `assets` must outlive the batch; `num_envs` and `num_threads` > 0. Results do not depend on the
@@ -41,6 +50,13 @@ class HostBatch {
   /// spawn point (else the finished step's; final_info() has that either way).
   HostBatch(std::unique_ptr<HostKernels> kernels, const AssetView& assets, int32_t num_envs, int32_t num_threads,
             bool info_shows_new_episode = true);
+  /// One batch over several parts (at least one environment in all; parts_problem() of their kernels empty),
+  /// each environment stepped and rendered by its part's kernels into its row of the one set of outputs: the
+  /// batch equals its parts run alone, row for row.
+  HostBatch(std::vector<HostPart> parts, int32_t num_threads, bool info_shows_new_episode = true);
+  /// Why parts with these kernels cannot make one batch (a frame or layout size unlike the first part's: they
+  /// must share one observation shape and one hidden game), or empty.
+  static std::string parts_problem(const std::vector<const HostKernels*>& kernels);
 
   /// Starts episode 0 of the environments with mask[env] != 0 (every one when `mask` is null) with the
   /// new seeds[env]; the others keep their state and outputs. No environment is final afterwards.
@@ -57,8 +73,11 @@ class HostBatch {
   std::string load_state(const uint8_t* data, size_t size, const std::string& spec_hash);
 
   int32_t size() const { return n_; }
-  const LatentParams& latent_params() const { return kernels_->latent(); }
-  const VisualParams& visual_params() const { return kernels_->visual(); }
+  /// The first part's parameters (every part has the same frame and layout sizes).
+  const LatentParams& latent_params() const { return parts_.front().kernels->latent(); }
+  const VisualParams& visual_params() const { return parts_.front().kernels->visual(); }
+  /// [N]: each environment's part (0 for a batch of one part).
+  const int32_t* part_index() const { return part_.data(); }
   size_t frame_bytes() const { return frame_; }
   const uint8_t* observations() const { return obs_.data(); }
   const uint8_t* observation(int32_t env) const { return obs_.data() + env * frame_; }
@@ -77,6 +96,7 @@ class HostBatch {
   Key episode_key(int32_t env) const { return fold(seed_key(seeds_[env]), latent_[env].episode); }
 
  private:
+  const HostPart& part(int32_t env) const { return parts_[static_cast<size_t>(part_[env])]; }
   EnvSlot slot(int32_t env, float* scratch) {
     return {&latent_[env], &visual_[env], segments_.data() + env * seg_bytes_, obs_.data() + env * frame_, scratch};
   }
@@ -85,8 +105,8 @@ class HostBatch {
   template <class Fn>
   void parallel_for(const Fn& fn);
 
-  std::unique_ptr<HostKernels> kernels_;
-  AssetView assets_;
+  std::vector<HostPart> parts_;
+  std::vector<int32_t> part_;  ///< [N] each environment's part
   int32_t n_;
   int32_t threads_;
   bool info_shows_new_episode_;

@@ -150,6 +150,38 @@ TEST_CASE("diff --certify: usage errors, certified and failing pairs", "[cli][di
   CHECK(old.err.find("--axis background or --certify=background") != std::string::npos);
 }
 
+TEST_CASE("diff --mixture: certified configs, a latent difference, usage errors", "[cli][diff][mixture]") {
+  const std::string base = "configs/kage_bench/bases/shape_black.yaml";
+  const std::string noise = "configs/kage_bench/background/1-eval.yaml";
+  const std::string few = "configs/kage_bench/distractors/5-eval.yaml";
+  TempDir tmp("diff_mixture");
+  const std::string cert = (tmp.path() / "mixture.json").string();
+  const CliRun ok = kagec({"diff", "--mixture", base, noise, few, "-o", cert});
+  INFO(ok.err);
+  CHECK(ok.code == 0);
+  CHECK(ok.out == "certified mixture: 3 configs, one hidden game and one observation shape; they differ on "
+                  "background, distractors\n");
+  const nlohmann::json j = nlohmann::json::parse(read_text(cert));
+  CHECK(j.at("kagec_mixture") == 1);
+  CHECK(j.at("configs").size() == 3);
+  CHECK(j.at("configs").at(2).at("name") == few);
+
+  const std::string longer = "tests/python/configs/long_episode.yaml";
+  const CliRun latent = kagec({"diff", "--mixture", "configs/throughput/simplest.yaml", longer});
+  CHECK(latent.code == 1);
+  CHECK(latent.out.empty());
+  CHECK(latent.err.find(longer + ":4:1: error: mixture of 'configs/throughput/simplest.yaml' and '" + longer +
+                        "': latent key 'episode_length' is 500 in 'configs/throughput/simplest.yaml' but 1000 in '" +
+                        longer + "'; a mixture's configs must run one hidden game and differ only on visual axes "
+                        "[certify-mixture-latent]") != std::string::npos);
+  CHECK(latent.err.find("kagec diff: not a mixture: fix the errors above first") != std::string::npos);
+
+  CHECK(kagec({"diff", "--mixture", base, noise, "--certify"}).code == 2);
+  const CliRun three = kagec({"diff", base, noise, few});
+  CHECK(three.code == 2);
+  CHECK(three.err.find("configs batched together are certified with --mixture") != std::string::npos);
+}
+
 TEST_CASE("diff: every order of the files, --certify, the axis and -o gives the same certificate", "[cli][diff]") {
   const std::string train = "configs/kage_bench/bases/shape_black.yaml";
   const std::string eval = "configs/kage_bench/background/1-eval.yaml";

@@ -198,6 +198,12 @@ const std::map<std::string, std::string>& rules_without_fixture() {
        "covered by the 'kagec lint of a missing file' test in cli_test.cpp"},
       {"extends-too-deep",
        "needs a chain of more than 64 files; covered by the 'a deep extends chain' test in hostile_input_test.cpp"},
+      {"certify-mixture-shape",
+       "compares several configs given together (kagec diff --mixture, kage.make_vec's mixtures), never one file; "
+       "covered by the mixture tests of diff_suite_test.cpp and cli_test.cpp"},
+      {"certify-mixture-latent",
+       "compares several configs given together (kagec diff --mixture, kage.make_vec's mixtures), never one file; "
+       "covered by the mixture tests of diff_suite_test.cpp and cli_test.cpp"},
   };
   return m;
 }

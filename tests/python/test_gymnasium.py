@@ -95,8 +95,8 @@ def test_a_make_without_config_or_with_a_bad_one_names_the_fix():
         gymnasium.make_vec("kage/KAGE-v0", num_envs=2, vectorization_mode="vector_entry_point")
     with pytest.raises(TypeError, match=r"config=5: a path \(str or os\.PathLike\) to a YAML config"):
         gymnasium.make("kage/KAGE-v0", config=5)
-    with pytest.raises(TypeError, match=r"config=\['a.yaml'\]: a path"):
-        kage.make_vec(["a.yaml"], 2)
+    with pytest.raises(TypeError, match=r"config=\{'a.yaml'\}: a path .*; or a list of YAML configs \(a mixture\)"):
+        kage.make_vec({"a.yaml"}, 2)
     with pytest.raises(ValueError, match=r"render_mode='rgb_array': kage/KAGE-v0's vector environment renders no "
                                          r"frames of its own"):
         gymnasium.make_vec("kage/KAGE-v0", num_envs=2, vectorization_mode="vector_entry_point", config=SIMPLEST,

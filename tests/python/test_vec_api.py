@@ -19,7 +19,8 @@ def test_shapes_and_dtypes():
         for name, dtype in expected.items():
             assert info[name].shape == (3,) and info[name].dtype == dtype, name
         assert info["final_obs"].shape == (3, 128, 128, 3)
-        assert set(info["final_info"]) == set(expected)
+        assert set(info["final_info"]) == set(expected) | {"config"}  # the runtime's fields and the batch's
+        assert info["config"].dtype == np.int32 and info["config"].tolist() == [0, 0, 0]
         assert info["_final"].dtype == bool and not info["_final"].any()
         assert info["timestep"].tolist() == [1, 1, 1] and info["length"].tolist() == [1, 1, 1]
         assert obs.any(), "the frame is not blank"

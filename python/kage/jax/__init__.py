@@ -7,7 +7,8 @@ pytree, each one typed XLA FFI call, so a PureJaxRL-style agent keeps its whole 
     step = jax.jit(env.step, donate_argnums=0)   # donation: XLA updates the state in place
     state, obs, reward, terminated, truncated, info = step(state, actions)
 
-See ``make_env``, ``JaxEnv`` and the README's "JAX" section (vmap, errors, tested versions).
+A list of configs that differ only on visual axes makes a mixture (``JaxMixture``, as ``kage.make_vec``'s).
+See ``make_env``, ``JaxEnv`` and the README's "JAX" section (vmap, mixtures, errors, tested versions).
 """
 try:
     import jax  # noqa: F401  (absolute: the real JAX, not this package)
@@ -15,6 +16,7 @@ except ImportError as e:
     raise ImportError("kage.jax needs JAX: `pip install jax` (CPU) or `pip install 'jax[cuda13]'` (NVIDIA GPUs); "
                       "see README, JAX, for the tested versions") from e
 
-from kage.jax.env import JaxEnv, KageState, make_env
+from kage.jax.env import JaxEnv, KageState
+from kage.jax.mixture import JaxMixture, MixtureState, make_env
 
-__all__ = ["JaxEnv", "KageState", "make_env"]
+__all__ = ["JaxEnv", "JaxMixture", "KageState", "MixtureState", "make_env"]

@@ -8,11 +8,14 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from kage import spaces, vector
+from kage import fields, spaces, vector
 from kage.jax import _ffi, _native
 from kage.jax.seeds import env_seed_words
 
 _INFO_NAMES = tuple(name for name, _, _ in vector.INFO_FIELDS)
+_BATCH_NAMES = ("config",)  # the batch's fields that JaxEnv._batch_fields fills
+if _BATCH_NAMES != fields.BATCH_FIELDS:
+    raise ImportError(f"kage.jax fills the batch fields {_BATCH_NAMES}, kage.fields lists {fields.BATCH_FIELDS}")
 _FINAL_KEYS = ("final_obs", "final_info", "_final", "_final_obs", "_final_info")
 
 
@@ -52,8 +55,8 @@ class JaxEnv:
     ``reset(seed) -> (state, obs, info)`` and ``step(state, actions) -> (state, obs, reward, terminated,
     truncated, info)``, with the names, shapes and dtypes of ``kage.make_vec``'s outputs: obs uint8
     [N, H, W, 3], reward float32 [N], flags and masks as make_vec gives them, info the fields of
-    ``kage.INFO_FIELDS`` plus the same-step autoreset keys ``final_obs``, ``final_info``, ``_final``,
-    ``_final_obs`` and ``_final_info``.
+    ``kage.INFO_FIELDS``, the batch's (``config``: 0, one config) and the same-step autoreset keys
+    ``final_obs``, ``final_info``, ``_final``, ``_final_obs`` and ``_final_info``.
 
     Same-step autoreset, as make_vec: a step that ends an episode returns its reward and flags, the next
     episode's first observation and info, and the finished episode's last observation and info in
@@ -89,7 +92,10 @@ class JaxEnv:
         """Starts episode 0 of every environment. ``seed``: a non-negative Python int, or a uint32 JAX
         scalar (traced or not); environment i gets ``kage.env_seeds(seed, num_envs)[i]``, as
         ``kage.make_vec``'s ``reset(seed=seed)`` gives it."""
-        words = self._seed_words(seed)
+        return self._reset_words(seed_words(seed, self.num_envs))
+
+    def _reset_words(self, words) -> Tuple[KageState, Any, Dict[str, Any]]:
+        """reset() with each environment's seed given: uint32 [num_envs, 2] (low, high) words."""
         s = self._state
         outs = _ffi.reset_call([s.latent, s.segments, s.visual, *self._outputs, *self._info.values()])(
             words, spec_hash=self.spec_hash)
@@ -132,44 +138,12 @@ class JaxEnv:
         call it outside ``jit`` (it reads the [N, 2] record from the device), e.g. after a scan. A state with
         leading vmap axes is checked whole. Inside ``jit``, ``vmap`` or ``scan`` it raises TypeError saying so."""
         self._check_state(state, batched=True)
-        if isinstance(state.action_error, jax.core.Tracer):
-            raise TypeError("env.check(state) reads the state's action record back from the device, so it runs outside "
-                            "jax.jit, vmap and scan: call it on the state that your jitted function returns (after the "
-                            "scan, say), not inside it")
-        record = np.asarray(jax.device_get(state.action_error))
-        hits = np.argwhere(record[..., 1] != 0)
-        if hits.size == 0:
-            return
-        steps = record[..., 1][tuple(hits.T)]
-        where = tuple(hits[np.lexsort((np.arange(len(hits)), steps))[0]])
-        value, step = record[where]
-        batch = f" of batch {where[:-1]}" if len(where) > 1 else ""
-        more = f" ({len(hits)} environments had one)" if len(hits) > 1 else ""
-        raise ValueError(f"kage.jax: the actions of step {step} held {value} for environment {where[-1]}{batch}"
-                         f"{more}: {vector.native().action_range_text()}; that step ran with the value masked to "
-                         "its low 3 bits")
+        check_action_record(state.action_error)
 
     def __repr__(self) -> str:
         return f"<kage.jax.JaxEnv {self.config!r}, {self.num_envs} envs, spec {self.spec_hash[:12]}>"
 
     # ---- checks at trace time ----
-
-    def _seed_words(self, seed):
-        n = self.num_envs
-        if isinstance(seed, (bool, np.bool_)):
-            raise TypeError(f"seed={seed!r}: a non-negative int or a uint32 scalar")
-        if isinstance(seed, (int, np.integer)):
-            if int(seed) < 0:
-                raise ValueError(f"seed={seed}: a non-negative integer (numpy's SeedSequence takes no negative seed)")
-            if int(seed) >= 2**32:  # beyond one uint32 word: the same seeds, derived on the host
-                return jnp.asarray(vector.env_seeds(int(seed), n).view(np.uint32).reshape(n, 2))
-            seed = jnp.uint32(seed)
-        if not hasattr(seed, "shape") or not hasattr(seed, "dtype"):
-            raise TypeError(f"seed: a non-negative int or a uint32 scalar, got {type(seed).__name__}")
-        if seed.shape != () or seed.dtype != jnp.uint32:
-            raise TypeError(f"seed: a non-negative int or a uint32 scalar, got {seed.dtype} of shape {seed.shape} "
-                            "(jnp.uint32(s) or x.astype(jnp.uint32); under vmap, one uint32 per batch)")
-        return env_seed_words(seed, n)
 
     def _check_state(self, state, batched: bool = False) -> None:
         if not isinstance(state, KageState):
@@ -203,10 +177,56 @@ class JaxEnv:
                             "actions.astype(jnp.int32))")
         return jnp.asarray(actions)
 
+    def _batch_fields(self) -> Dict[str, Any]:
+        """The batch's fields (kage.fields.BATCH_FIELDS), constants of the graph: one config, index 0."""
+        return {"config": jnp.zeros((self.num_envs,), jnp.int32)}
+
     def _with_final(self, info: Dict[str, Any], state: KageState, final_mask) -> Dict[str, Any]:
-        out = dict(info)
-        out.update(zip(_FINAL_KEYS, (state.final_obs, state.final_info, final_mask, final_mask, final_mask)))
+        batch = self._batch_fields()
+        out = dict(info, **batch)
+        final_info = dict(state.final_info, **batch)  # a finished episode ran the same config
+        out.update(zip(_FINAL_KEYS, (state.final_obs, final_info, final_mask, final_mask, final_mask)))
         return out
+
+
+def seed_words(seed, n: int):
+    """uint32 [n, 2]: the seeds of ``kage.env_seeds(seed, n)`` as (low, high) words, for a non-negative int or a
+    uint32 JAX scalar (traced or not); TypeError or ValueError naming what the seed should be."""
+    if isinstance(seed, (bool, np.bool_)):
+        raise TypeError(f"seed={seed!r}: a non-negative int or a uint32 scalar")
+    if isinstance(seed, (int, np.integer)):
+        if int(seed) < 0:
+            raise ValueError(f"seed={seed}: a non-negative integer (numpy's SeedSequence takes no negative seed)")
+        if int(seed) >= 2**32:  # beyond one uint32 word: the same seeds, derived on the host
+            return jnp.asarray(vector.env_seeds(int(seed), n).view(np.uint32).reshape(n, 2))
+        seed = jnp.uint32(seed)
+    if not hasattr(seed, "shape") or not hasattr(seed, "dtype"):
+        raise TypeError(f"seed: a non-negative int or a uint32 scalar, got {type(seed).__name__}")
+    if seed.shape != () or seed.dtype != jnp.uint32:
+        raise TypeError(f"seed: a non-negative int or a uint32 scalar, got {seed.dtype} of shape {seed.shape} "
+                        "(jnp.uint32(s) or x.astype(jnp.uint32); under vmap, one uint32 per batch)")
+    return env_seed_words(seed, n)
+
+
+def check_action_record(action_error) -> None:
+    """Raises ValueError naming the first out-of-range action of an action record ([..., N, 2], leading vmap
+    axes allowed), TypeError inside jit, vmap or scan."""
+    if isinstance(action_error, jax.core.Tracer):
+        raise TypeError("env.check(state) reads the state's action record back from the device, so it runs outside "
+                        "jax.jit, vmap and scan: call it on the state that your jitted function returns (after the "
+                        "scan, say), not inside it")
+    record = np.asarray(jax.device_get(action_error))
+    hits = np.argwhere(record[..., 1] != 0)
+    if hits.size == 0:
+        return
+    steps = record[..., 1][tuple(hits.T)]
+    where = tuple(hits[np.lexsort((np.arange(len(hits)), steps))[0]])
+    value, step = record[where]
+    batch = f" of batch {where[:-1]}" if len(where) > 1 else ""
+    more = f" ({len(hits)} environments had one)" if len(hits) > 1 else ""
+    raise ValueError(f"kage.jax: the actions of step {step} held {value} for environment {where[-1]}{batch}"
+                     f"{more}: {vector.native().action_range_text()}; that step ran with the value masked to "
+                     "its low 3 bits")
 
 
 def _host_actions(actions, num_envs: int):
@@ -230,8 +250,9 @@ def _host_actions(actions, num_envs: int):
     return jnp.asarray(values.astype(np.int32))
 
 
-def make_env(config: Union[str, os.PathLike], num_envs: int, asset_root=None) -> JaxEnv:
-    """``num_envs`` environments of ``config`` (a YAML file or a ``kagec compile`` directory) for JAX.
+def make_config_env(config: Union[str, os.PathLike], num_envs: int, asset_root=None) -> JaxEnv:
+    """``num_envs`` environments of ``config`` (a YAML file or a ``kagec compile`` directory) for JAX
+    (``kage.jax.make_env`` for one config).
 
     Raises what ``kage.make_vec`` raises for the same config: ``kage.ConfigError`` with kagec's located
     diagnostics, ``FileNotFoundError``, ``ValueError`` for bad arguments. ``asset_root`` as make_vec's.
