@@ -56,34 +56,51 @@ int cmd_suite(const std::vector<std::string>& args, CommandIo& io) {
     print_text(diags, io.err, io.err_is_terminal);
     return kExitErrors;
   }
+  const fs::path dir = out_dir.empty() ? fs::path("out") / suite->name : fs::path(out_dir);
+  // The report and its certificates replace the directory whole (no certificate of an earlier run
+  // survives beside them), and only a directory that holds nothing but an earlier report is replaced.
+  if (const auto problem = suite_output_dir_problem(dir)) {
+    io.err << "kagec suite: " << *problem << '\n';
+    return kExitUsage;
+  }
   const SuiteReport report =
       run_suite(*suite, opts.resolve_options(), sources, reader, diags, io.err_is_terminal ? &io.err : nullptr);
   if (!verbose) diags.disable_warnings();
   print_text(diags, io.err, io.err_is_terminal);
   print_suite_table(*suite, report, io.out);
 
-  const fs::path dir = out_dir.empty() ? fs::path("out") / suite->name : fs::path(out_dir);
-  std::error_code ec;
-  fs::create_directories(dir / "certificates", ec);
-  if (ec) {
-    io.err << "kagec suite: cannot create '" << (dir / "certificates").string() << "': " << ec.message() << '\n';
-    return kExitErrors;
-  }
   Json json = suite_report_json(*suite, report);
   size_t isolation_failures = 0;
   if (compile) isolation_failures = add_isolation_evidence(report, json, io.out);
   std::string error;
-  bool written = write_file((dir / "report.json").string(), json_file_text(json), &error);
-  for (const Json& pair : json.at("pairs")) {
-    if (!written) break;
-    written = write_file((dir / "certificates" / certificate_file_name(pair.at("pair").get<std::string>())).string(),
-                         json_file_text(pair), &error);
-  }
-  if (!written) {
+  const std::optional<fs::path> staging = make_staging_dir(dir, &error);
+  if (!staging) {
     io.err << "kagec suite: " << error << '\n';
     return kExitErrors;
   }
-  io.out << "report: " << (dir / "report.json").string() << '\n';
+  struct Cleanup {  // removes the staging directory unless it was published
+    fs::path path;
+    ~Cleanup() {
+      std::error_code ec;
+      if (!path.empty()) fs::remove_all(path, ec);
+    }
+  } cleanup{*staging};
+  std::error_code ec;
+  fs::create_directory(*staging / kSuiteCertificateDir, ec);
+  bool written = !ec;
+  if (ec) error = "cannot create '" + (*staging / kSuiteCertificateDir).string() + "': " + ec.message();
+  if (written) written = write_file((*staging / kSuiteReportFile).string(), json_file_text(json), &error);
+  for (const Json& pair : json.at("pairs")) {
+    if (!written) break;
+    written = write_file((*staging / kSuiteCertificateDir / certificate_file_name(pair.at("pair").get<std::string>())).string(),
+                         json_file_text(pair), &error);
+  }
+  if (!written || !publish_staging_dir(*staging, dir, &error)) {
+    io.err << "kagec suite: " << error << '\n';
+    return kExitErrors;
+  }
+  cleanup.path.clear();
+  io.out << "report: " << (dir / kSuiteReportFile).string() << '\n';
   return report.passed() == report.results.size() && isolation_failures == 0 ? kExitOk : kExitErrors;
 }
 

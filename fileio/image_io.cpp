@@ -7,13 +7,14 @@
 
 #include <fmt/format.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 
 namespace kage {
 namespace {
@@ -56,7 +57,115 @@ bool png_has_iend(const uint8_t* d, size_t n) {
   return false;
 }
 
+uint32_t be16(const uint8_t* p) { return uint32_t(p[0]) << 8 | p[1]; }
+uint32_t be32(const uint8_t* p) { return be16(p) << 16 | be16(p + 2); }
+uint32_t le16(const uint8_t* p) { return uint32_t(p[1]) << 8 | p[0]; }
+uint32_t le32(const uint8_t* p) { return le16(p + 2) << 16 | le16(p); }
+
+// Width and height as the header states them, read from the first bytes only: a file can claim a
+// size that stb_image refuses with an unrelated reason ("unknown image type"), or that would take
+// gigabytes to decode.
+std::optional<std::pair<int64_t, int64_t>> header_dimensions(const uint8_t* d, size_t n) {
+  switch (sniff(d, n)) {
+    case Format::kPng:
+      if (n >= 24 && std::memcmp(d + 12, "IHDR", 4) == 0) return std::make_pair(int64_t(be32(d + 16)), int64_t(be32(d + 20)));
+      return std::nullopt;
+    case Format::kGif:
+      if (n >= 10) return std::make_pair(int64_t(le16(d + 6)), int64_t(le16(d + 8)));
+      return std::nullopt;
+    case Format::kBmp: {
+      if (n < 26) return std::nullopt;
+      if (le32(d + 14) == 12) return std::make_pair(int64_t(le16(d + 18)), int64_t(le16(d + 20)));
+      const int64_t w = int32_t(le32(d + 18)), h = int32_t(le32(d + 22));  // a negative height is top-down
+      return std::make_pair(w < 0 ? -w : w, h < 0 ? -h : h);
+    }
+    case Format::kJpeg:
+      // Segments up to the first frame header (SOF0..SOF15 but DHT, JPG and DAC); none before the scan.
+      for (size_t i = 2; i + 9 < n;) {
+        if (d[i] != 0xFF) return std::nullopt;
+        const uint8_t marker = d[i + 1];
+        if (marker == 0xFF) {
+          ++i;  // fill byte
+          continue;
+        }
+        if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {
+          i += 2;
+          continue;
+        }
+        if (marker == 0xDA || marker == 0xD9) return std::nullopt;
+        if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
+          return std::make_pair(int64_t(be16(d + i + 7)), int64_t(be16(d + i + 5)));
+        i += 2 + be16(d + i + 2);
+      }
+      return std::nullopt;
+    case Format::kUnknown:
+      break;
+  }
+  return std::nullopt;
+}
+
+std::string too_large_text(int64_t w, int64_t h) {
+  return fmt::format("image too large: {}x{} pixels, more than {} ({}x{}); use a smaller image", w, h, kMaxImagePixels,
+                     4096, 4096);
+}
+
 }  // namespace
+
+std::optional<std::string> header_size_problem(const uint8_t* data, size_t size) {
+  const auto dims = header_dimensions(data, size);
+  if (!dims || dims->first * dims->second <= kMaxImagePixels) return std::nullopt;
+  return too_large_text(dims->first, dims->second);
+}
+
+ImageFileBytes read_image_file(const std::string& path) {
+  ImageFileBytes r;
+  auto fail = [&](ImageError kind, std::string reason) {
+    r.kind = kind;
+    r.reason = std::move(reason);
+    r.error = fmt::format("{}: {}", path, r.reason);
+    return r;
+  };
+  // Opened without blocking, then checked: a FIFO or device is refused before a read could hang or
+  // run without end, and a huge file before it is read.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    if (errno == ENOENT || errno == ENOTDIR) return fail(ImageError::kMissing, "no such file; fix the path");
+    return fail(ImageError::kUnreadable, fmt::format("cannot open ({})", std::strerror(errno)));
+  }
+  struct stat st {};
+  std::string reason;
+  ImageError kind = ImageError::kUnreadable;
+  if (::fstat(fd, &st) != 0) {
+    reason = fmt::format("cannot read its status ({})", std::strerror(errno));
+  } else if (S_ISDIR(st.st_mode)) {
+    r.not_a_file = true;
+    reason = "is a directory, not an image file; name an image file";
+  } else if (!S_ISREG(st.st_mode)) {
+    r.not_a_file = true;
+    reason = "is not a regular file (a FIFO, device or socket); name an image file";
+  } else if (uint64_t(st.st_size) > kMaxImageFileBytes) {
+    kind = ImageError::kTooLarge;
+    reason = fmt::format("is {} bytes, more than an image file may be ({} MiB); use a smaller image",
+                         uint64_t(st.st_size), kMaxImageFileBytes >> 20);
+  } else {
+    std::string bytes(size_t(st.st_size), '\0');
+    size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t got = ::read(fd, bytes.data() + done, bytes.size() - done);
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) break;
+      done += size_t(got);
+    }
+    if (done == bytes.size()) {
+      r.bytes = std::move(bytes);
+    } else {
+      reason = "read error (the file changed or could not be read); check it";
+    }
+  }
+  ::close(fd);
+  if (r.ok()) return r;
+  return fail(kind, reason);
+}
 
 ImageResult decode_image(const uint8_t* data, size_t size, int channels, const std::string& name) {
   if (channels != 3 && channels != 4) {
@@ -67,6 +176,8 @@ ImageResult decode_image(const uint8_t* data, size_t size, int channels, const s
   if (format == Format::kUnknown) {
     return fail(ImageError::kUnsupported, name, "unsupported or corrupt image format (not PNG, JPEG, BMP or GIF)");
   }
+  if (const std::optional<std::string> too_large = header_size_problem(data, size))
+    return fail(ImageError::kTooLarge, name, *too_large);
   if (format == Format::kJpeg && !jpeg_has_eoi(data, size)) {
     return fail(ImageError::kCorrupt, name, "corrupt JPEG: truncated (no end-of-image marker)");
   }
@@ -75,11 +186,8 @@ ImageResult decode_image(const uint8_t* data, size_t size, int channels, const s
   }
   if (size > size_t(INT32_MAX)) return fail(ImageError::kUnsupported, name, "file too large");
   int w = 0, h = 0, n = 0;
-  if (stbi_info_from_memory(data, int(size), &w, &h, &n) && int64_t(w) * int64_t(h) > kMaxImagePixels) {
-    return fail(ImageError::kTooLarge, name,
-                fmt::format("image too large: {}x{} pixels, more than {} ({}x{}); use a smaller image", w, h,
-                            kMaxImagePixels, 4096, 4096));
-  }
+  if (stbi_info_from_memory(data, int(size), &w, &h, &n) && int64_t(w) * int64_t(h) > kMaxImagePixels)
+    return fail(ImageError::kTooLarge, name, too_large_text(w, h));
   stbi_uc* px = stbi_load_from_memory(data, int(size), &w, &h, &n, channels);
   if (px == nullptr) {
     const char* why = stbi_failure_reason();
@@ -103,16 +211,14 @@ ImageResult decode_image(const uint8_t* data, size_t size, int channels, const s
 }
 
 ImageResult load_image(const std::string& path, int channels) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (!fs::exists(st)) return fail(ImageError::kMissing, path, "no such file");
-  if (fs::is_directory(st)) return fail(ImageError::kUnreadable, path, "is a directory, not an image file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(ImageError::kUnreadable, path, fmt::format("cannot open ({})", std::strerror(errno)));
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return fail(ImageError::kUnreadable, path, "read error");
-  return decode_image(bytes.data(), bytes.size(), channels, path);
+  const ImageFileBytes file = read_image_file(path);
+  if (!file.ok()) {
+    ImageResult r;
+    r.kind = file.kind;
+    r.error = file.error;
+    return r;
+  }
+  return decode_image(reinterpret_cast<const uint8_t*>(file.bytes->data()), file.bytes->size(), channels, path);
 }
 
 namespace {

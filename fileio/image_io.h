@@ -54,6 +54,29 @@ struct [[nodiscard]] IoStatus {
 /// decoding it would take seconds and gigabytes. Checked from the header, before decoding.
 inline constexpr int64_t kMaxImagePixels = int64_t(4096) * 4096;
 
+/// The largest image file read: a 4096 x 4096 RGBA BMP (the largest image kMaxImagePixels allows) is
+/// 64 MiB, a PNG or JPEG of it less. A larger file is refused by its size before any byte is read.
+inline constexpr uint64_t kMaxImageFileBytes = uint64_t(256) << 20;
+
+/// An image file's bytes, or why they were not read: kMissing, kUnreadable (a directory, a FIFO or
+/// device, an open or read error) or kTooLarge (more than kMaxImageFileBytes). `reason` says what the
+/// path is and how to fix it; `error` is "path: reason".
+struct [[nodiscard]] ImageFileBytes {
+  std::optional<std::string> bytes;
+  ImageError kind = ImageError::kNone;
+  bool not_a_file = false;  ///< a directory, FIFO, device or socket (kUnreadable)
+  std::string reason;
+  std::string error;
+  bool ok() const { return bytes.has_value(); }
+};
+
+/// Reads `path` after checking, without blocking, that it is a regular file of a readable size.
+ImageFileBytes read_image_file(const std::string& path);
+
+/// "image too large: WxH pixels, ..." when the header of a PNG, JPEG, BMP or GIF (the first bytes of
+/// `data`) states more than kMaxImagePixels pixels; nullopt otherwise (no header found included).
+std::optional<std::string> header_size_problem(const uint8_t* data, size_t size);
+
 /// Loads `path` and converts it to `channels` (3 = RGB, 4 = RGBA) like Pillow's
 /// `convert`: grey is replicated, alpha is dropped for RGB and set to 255 when
 /// absent. PNG, JPEG and BMP (and the first frame of a GIF) are accepted.

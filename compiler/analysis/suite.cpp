@@ -1,11 +1,16 @@
 // Suite manifests: loading, running, reporting.
 #include "compiler/analysis/suite.h"
 
+#include <algorithm>
 #include <cctype>
+#include <fstream>
 #include <iomanip>
 #include <map>
 #include <ostream>
+#include <set>
+#include <sstream>
 
+#include "compiler/basic/file_out.h"
 #include "compiler/parse/compose.h"
 
 namespace kage {
@@ -332,6 +337,60 @@ Json suite_report_json(const Suite& suite, const SuiteReport& report) {
               {"pairs", pairs},
               {"passed", report.passed()},
               {"total", report.results.size()}};
+}
+
+std::optional<std::string> suite_output_dir_problem(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  if (std::optional<std::string> problem = output_dir_kind_problem(dir)) return problem;
+  std::error_code ec;
+  if (!fs::exists(dir, ec) || fs::is_empty(dir, ec)) return std::nullopt;
+  const std::string name = dir.string();
+  const std::string fix = "; kagec suite replaces its output directory whole, so name a new or empty directory with -o";
+  const fs::path report_path = dir / kSuiteReportFile;
+  const fs::file_status report_status = fs::symlink_status(report_path, ec);
+  if (!fs::exists(report_status))
+    return "'" + name + "' holds files that kagec did not write (it has no " + kSuiteReportFile + ")" + fix;
+  Json report;
+  if (fs::is_regular_file(report_status) && fs::file_size(report_path, ec) <= (uintmax_t(64) << 20)) {
+    std::ifstream in(report_path, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    report = Json::parse(text.str(), nullptr, false);
+  }
+  if (!report.is_object() || report.value("kagec_suite_report", 0) != 1 || !report.value("pairs", Json()).is_array())
+    return "'" + report_path.string() + "' is not a kagec suite report, so kagec did not write '" + name + "'" + fix;
+  std::set<std::string> certificates;
+  for (const Json& pair : report.at("pairs"))
+    if (pair.is_object() && pair.value("pair", Json()).is_string())
+      certificates.insert(certificate_file_name(pair.value("pair", "")));
+  // Every entry must be one the report accounts for: report.json, certificates/ and its pairs' files.
+  std::vector<std::string> foreign;
+  auto judge = [&](const fs::path& folder, const std::string& prefix, auto&& allowed) {
+    std::error_code list_ec;
+    for (const fs::directory_entry& e : fs::directory_iterator(folder, list_ec)) {
+      const std::string entry = e.path().filename().string();
+      if (!allowed(entry, e)) foreign.push_back(prefix + entry);
+    }
+    if (list_ec) foreign.push_back(prefix + " (cannot be listed: " + list_ec.message() + ")");
+  };
+  judge(dir, "", [&](const std::string& entry, const fs::directory_entry& e) {
+    std::error_code st;
+    if (e.is_symlink(st)) return false;
+    if (entry == kSuiteReportFile) return e.is_regular_file(st);
+    return entry == kSuiteCertificateDir && e.is_directory(st);
+  });
+  if (fs::is_directory(fs::symlink_status(dir / kSuiteCertificateDir, ec)))
+    judge(dir / kSuiteCertificateDir, std::string(kSuiteCertificateDir) + "/",
+          [&](const std::string& entry, const fs::directory_entry& e) {
+            std::error_code st;
+            return certificates.count(entry) && e.is_regular_file(st) && !e.is_symlink(st);
+          });
+  if (foreign.empty()) return std::nullopt;
+  std::sort(foreign.begin(), foreign.end());
+  const std::string more = foreign.size() > 1 ? " and " + std::to_string(foreign.size() - 1) + " more" : "";
+  return "'" + name + "' holds '" + foreign.front() + "'" + more + ", which its " + kSuiteReportFile +
+         " does not account for (kagec did not write it); move such files out of the directory, or name a new or "
+         "empty directory with -o (kagec suite replaces its output directory whole)";
 }
 
 }  // namespace kage

@@ -2,6 +2,7 @@
 // each linted, resolved, diffed and certified against its declared axis.
 #pragma once
 
+#include <filesystem>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -70,5 +71,15 @@ SuiteReport run_suite(const Suite& suite, const ResolveOptions& options, SourceM
 void print_suite_table(const Suite& suite, const SuiteReport& report, std::ostream& out);
 /// The JSON report, with a certificate per pair.
 Json suite_report_json(const Suite& suite, const SuiteReport& report);
+
+/// The file name of a suite's report inside its output directory, and the folder of its certificates.
+inline constexpr const char* kSuiteReportFile = "report.json";
+inline constexpr const char* kSuiteCertificateDir = "certificates";
+
+/// Why `dir` cannot receive a suite's report, or nullopt when it can: it is absent, empty, or an
+/// earlier `kagec suite` output, that is report.json (a kagec suite report) and certificates/ holding
+/// only the certificates of that report's pairs. Anything else is left alone, since the report
+/// replaces its directory whole.
+std::optional<std::string> suite_output_dir_problem(const std::filesystem::path& dir);
 
 }  // namespace kage

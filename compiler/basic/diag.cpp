@@ -45,19 +45,33 @@ Diagnostic& DiagEngine::report(Rule rule, Range range, std::string message, std:
   return diags_.back();
 }
 
+const std::map<uint32_t, std::string_view>& DiagEngine::disable_comments(FileId file) const {
+  const auto found = disable_comments_.find(file);
+  if (found != disable_comments_.end()) return found->second;
+  std::map<uint32_t, std::string_view>& lines = disable_comments_[file];
+  const std::string_view text = sources_.text(file);
+  static constexpr std::string_view kMarker = "kagec: disable=";
+  for (size_t at = text.find(kMarker); at != std::string_view::npos; at = text.find(kMarker, at + 1)) {
+    std::string_view list = text.substr(at + kMarker.size());
+    list = list.substr(0, list.find_first_of(" \t#\r\n"));
+    const uint32_t line = sources_.line_col(Loc{file, static_cast<uint32_t>(at)}).line;
+    lines.emplace(line, list);  // the first comment of a line counts, as before
+  }
+  return lines;
+}
+
 // `# kagec: disable=RULE[,RULE]` on the diagnostic's line or the line above.
 bool DiagEngine::suppressed(const Diagnostic& d) const {
   const char* id = rule_info(d.rule).id;
   if (disabled_.count(id)) return true;
   if (no_warnings_ && d.severity == Severity::Warning) return true;
   if (!d.range.begin.valid()) return false;
-  const std::string& text = sources_.text(d.range.begin.file);
-  const LineCol lc = sources_.line_col(d.range.begin);
-  auto mentions = [&](std::string_view line) {
-    const auto at = line.find("kagec: disable=");
-    if (at == std::string_view::npos) return false;
-    std::string_view list = line.substr(at + 15);
-    list = list.substr(0, list.find_first_of(" \t#"));
+  const std::map<uint32_t, std::string_view>& comments = disable_comments(d.range.begin.file);
+  if (comments.empty()) return false;
+  auto mentions = [&](uint32_t line) {
+    const auto it = comments.find(line);
+    if (it == comments.end()) return false;
+    std::string_view list = it->second;
     while (!list.empty()) {
       const auto comma = list.find(',');
       if (list.substr(0, comma) == id) return true;
@@ -66,16 +80,8 @@ bool DiagEngine::suppressed(const Diagnostic& d) const {
     }
     return false;
   };
-  if (mentions(sources_.line_text(d.range.begin))) return true;
-  if (lc.line > 1) {
-    uint32_t prev_end = d.range.begin.offset - (lc.col - 1);
-    if (prev_end > 0) {
-      uint32_t start = prev_end - 1;
-      while (start > 0 && text[start - 1] != '\n') --start;
-      if (mentions(sources_.line_text(Loc{d.range.begin.file, start}))) return true;
-    }
-  }
-  return false;
+  const uint32_t line = sources_.line_col(d.range.begin).line;
+  return mentions(line) || (line > 1 && mentions(line - 1));
 }
 
 std::vector<Diagnostic> DiagEngine::sorted() const {
@@ -94,13 +100,13 @@ std::vector<Diagnostic> DiagEngine::sorted() const {
 
 size_t DiagEngine::error_count() const {
   size_t n = 0;
-  for (const Diagnostic& d : sorted()) n += d.severity == Severity::Error;
+  for (const Diagnostic& d : diags_) n += d.severity == Severity::Error && !suppressed(d);
   return n;
 }
 
 size_t DiagEngine::warning_count() const {
   size_t n = 0;
-  for (const Diagnostic& d : sorted()) n += d.severity == Severity::Warning;
+  for (const Diagnostic& d : diags_) n += d.severity == Severity::Warning && !suppressed(d);
   return n;
 }
 
@@ -112,36 +118,64 @@ std::string location_prefix(const SourceManager& sm, Loc loc) {
   return sm.name(loc.file) + ":" + std::to_string(lc.line) + ":" + std::to_string(lc.col);
 }
 
-/// `text` with control characters as \xNN: a file name or value holding an escape sequence must not
-/// drive the terminal, nor a newline split a diagnostic.
+/// How a byte is shown: control characters as escapes (\0, \t, \n, \r, else \xNN), so that a file
+/// name, key or source line holding one can neither drive the terminal nor split a diagnostic.
+std::string_view shown_byte(char c, char (&buf)[5], bool raw_tab = false) {
+  const auto u = static_cast<unsigned char>(c);
+  if ((u >= 0x20 && u != 0x7f) || (raw_tab && c == '\t')) {
+    buf[0] = c;
+    return {buf, 1};
+  }
+  switch (c) {
+    case '\0': return "\\0";
+    case '\t': return "\\t";
+    case '\n': return "\\n";
+    case '\r': return "\\r";
+    default: break;
+  }
+  static const char kHex[] = "0123456789abcdef";
+  buf[0] = '\\';
+  buf[1] = 'x';
+  buf[2] = kHex[u >> 4];
+  buf[3] = kHex[u & 15];
+  return {buf, 4};
+}
+
 std::string printable(std::string_view text) {
   std::string out;
-  for (char c : text) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u < 0x20 || u == 0x7f) {
-      static const char kHex[] = "0123456789abcdef";
-      out += "\\x";
-      out += kHex[u >> 4];
-      out += kHex[u & 15];
-    } else {
-      out += c;
-    }
-  }
+  char buf[5];
+  for (char c : text) out += shown_byte(c, buf);
   return out;
 }
 
+/// The source line of `range` and a caret line under it: at most kMaxSnippetBytes of the line (a window
+/// around the caret, "..." marking what is cut), each byte shown as printable() shows it but a tab,
+/// which stays a tab in both lines so that the caret lines up.
 void print_snippet(const SourceManager& sm, const Range& range, std::ostream& out) {
   if (!range.begin.valid()) return;
   const std::string_view line = sm.line_text(range.begin);
   const LineCol lc = sm.line_col(range.begin);
-  out << line << '\n';
-  std::string marker;
-  for (uint32_t i = 1; i < lc.col && i <= line.size(); ++i) marker += line[i - 1] == '\t' ? '\t' : ' ';
-  marker += '^';
-  const uint32_t line_end = range.begin.offset - (lc.col - 1) + static_cast<uint32_t>(line.size());
-  const uint32_t end = std::min(range.end, line_end);
-  for (uint32_t i = range.begin.offset + 1; i < end; ++i) marker += '~';
-  out << marker << '\n';
+  const size_t caret = std::min<size_t>(lc.col - 1, line.size());
+  size_t from = 0, to = line.size();
+  if (line.size() > kMaxSnippetBytes) {
+    from = caret > kMaxSnippetBytes / 3 ? caret - kMaxSnippetBytes / 3 : 0;
+    to = std::min(line.size(), from + kMaxSnippetBytes);
+    from = to - std::min(to, kMaxSnippetBytes);
+  }
+  const uint32_t line_begin = range.begin.offset - (lc.col - 1);
+  const size_t end = std::max<size_t>(caret + 1, std::min<size_t>(range.end - line_begin, to));
+  std::string text = from > 0 ? "..." : "", marker = from > 0 ? "   " : "";
+  char buf[5];
+  for (size_t i = from; i < to; ++i) {
+    const std::string_view shown = shown_byte(line[i], buf, true);
+    text += shown;
+    const char mark = i == caret ? '^' : i > caret && i < end ? '~' : line[i] == '\t' ? '\t' : ' ';
+    marker.append(shown.size(), mark);
+  }
+  if (caret >= to) marker += '^';
+  if (to < line.size()) text += "...";
+  while (!marker.empty() && marker.back() == ' ') marker.pop_back();
+  out << text << '\n' << marker << '\n';
 }
 
 }  // namespace
@@ -150,7 +184,28 @@ void print_text(const DiagEngine& engine, std::ostream& out, bool color) {
   const SourceManager& sm = engine.sources();
   const char* bold = color ? "\033[1m" : "";
   const char* reset = color ? "\033[0m" : "";
-  for (const Diagnostic& d : engine.sorted()) {
+  const std::vector<Diagnostic> all = engine.sorted();
+  size_t shown = 0;  // of the current file
+  for (size_t i = 0; i < all.size(); ++i) {
+    const Diagnostic& d = all[i];
+    const std::string file = d.range.begin.valid() ? sm.name(d.range.begin.file) : "";
+    shown = i > 0 && file == (all[i - 1].range.begin.valid() ? sm.name(all[i - 1].range.begin.file) : "") ? shown + 1 : 1;
+    if (shown > kMaxShownPerFile) {
+      size_t errors = 0, warnings = 0;
+      for (; i < all.size(); ++i) {
+        const Diagnostic& rest = all[i];
+        if ((rest.range.begin.valid() ? sm.name(rest.range.begin.file) : "") != file) break;
+        errors += rest.severity == Severity::Error;
+        warnings += rest.severity == Severity::Warning;
+      }
+      --i;  // the loop's ++i moves to the next file
+      auto count = [](size_t n, const char* what) { return std::to_string(n) + " more " + what + (n == 1 ? "" : "s"); };
+      out << printable(file.empty() ? "kagec" : file) << ": note: "
+          << (errors ? count(errors, "error") : "") << (errors && warnings ? " and " : "")
+          << (warnings ? count(warnings, "warning") : "") << (errors || warnings ? "" : "more notes")
+          << " not shown; fix the ones above first, or list them all with --format json\n";
+      continue;
+    }
     const char* sev_color = !color ? "" : d.severity == Severity::Error ? "\033[1;31m" : "\033[1;35m";
     out << bold << printable(location_prefix(sm, d.range.begin)) << ": " << reset << sev_color
         << severity_name(d.severity) << ": " << reset << bold << printable(d.message) << " [" << rule_info(d.rule).id

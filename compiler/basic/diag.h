@@ -6,8 +6,10 @@
 #pragma once
 
 #include <iosfwd>
+#include <map>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "compiler/basic/source.h"
@@ -78,14 +80,24 @@ class DiagEngine {
 
  private:
   bool suppressed(const Diagnostic& d) const;
+  /// The `kagec: disable=` lists of a file by line, found in one pass over its text.
+  const std::map<uint32_t, std::string_view>& disable_comments(FileId file) const;
   const SourceManager& sources_;
   std::vector<Diagnostic> diags_;
+  mutable std::map<FileId, std::map<uint32_t, std::string_view>> disable_comments_;
   std::set<std::string> disabled_;
   bool werror_ = false;
   bool no_warnings_ = false;
 };
 
-/// `file:line:col: severity: message [rule]`, the source line with a caret, notes and fix-its.
+/// The most diagnostics print_text shows per file; the rest are counted in one closing note.
+inline constexpr size_t kMaxShownPerFile = 100;
+/// The most bytes of a source line print_text shows (a window around the caret on longer lines).
+inline constexpr size_t kMaxSnippetBytes = 160;
+
+/// `file:line:col: severity: message [rule]`, the source line with a caret, notes and fix-its; control
+/// characters are escaped (\0, \t, \x1b). After kMaxShownPerFile diagnostics of one file, a note
+/// says how many more errors and warnings it has.
 void print_text(const DiagEngine& engine, std::ostream& out, bool color = false);
 /// The frozen JSON form: {version, diagnostics: [...], summary}.
 void print_json(const DiagEngine& engine, std::ostream& out);

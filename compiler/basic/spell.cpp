@@ -2,17 +2,30 @@
 #include "compiler/basic/spell.h"
 
 #include <algorithm>
-#include <cctype>
 
 namespace kage {
 
+namespace {
+
+char lower(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
+
+bool equal_ignoring_case(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (lower(a[i]) != lower(b[i])) return false;
+  return true;
+}
+
+}  // namespace
+
 size_t edit_distance(const std::string& a, const std::string& b, bool ignore_case) {
-  auto eq = [&](char x, char y) {
-    return ignore_case ? std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y))
-                       : x == y;
-  };
-  // Optimal string alignment: three rows, since a transposition looks two rows back.
-  std::vector<size_t> before(b.size() + 1), prev(b.size() + 1), cur(b.size() + 1);
+  auto eq = [&](char x, char y) { return ignore_case ? lower(x) == lower(y) : x == y; };
+  // Optimal string alignment: three rows, since a transposition looks two rows back. The rows are
+  // kept between calls (did-you-mean runs once per unknown key and candidate).
+  thread_local std::vector<size_t> before, prev, cur;
+  before.assign(b.size() + 1, 0);
+  prev.resize(b.size() + 1);
+  cur.assign(b.size() + 1, 0);
   for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
   for (size_t i = 1; i <= a.size(); ++i) {
     cur[0] = i;
@@ -29,12 +42,16 @@ size_t edit_distance(const std::string& a, const std::string& b, bool ignore_cas
 
 std::optional<std::string> suggest(const std::string& word, const std::vector<std::string>& candidates) {
   for (const std::string& c : candidates)
-    if (c != word && edit_distance(word, c, true) == 0) return c;
+    if (c != word && equal_ignoring_case(word, c)) return c;
   const size_t limit = std::min<size_t>(3, std::max<size_t>(1, word.size() / 3));
   size_t best = limit + 1;
   std::optional<std::string> pick;
   bool tie = false;
   for (const std::string& c : candidates) {
+    // The distance is at least the difference in length: most candidates need no table at all, and
+    // a hostile file of a million unknown keys costs a million short comparisons.
+    const size_t apart = c.size() > word.size() ? c.size() - word.size() : word.size() - c.size();
+    if (apart > limit) continue;
     const size_t d = edit_distance(word, c, true);
     if (d < best) {
       best = d;

@@ -1,12 +1,9 @@
 // Compile directories: safe names, staging and publishing, the manifest, reading back (see compiled_dir.h).
 #include "compiler/codegen/compiled_dir.h"
 
-#include <unistd.h>
-
-#include <cstdlib>
+#include <algorithm>
 #include <cstring>
 #include <fstream>
-#include <random>
 #include <sstream>
 
 #include "compiler/basic/file_out.h"
@@ -19,6 +16,9 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
 namespace {
+
+// A manifest is a few KB; a larger file named manifest.json is not one (and is not read whole).
+constexpr uintmax_t kMaxManifestBytes = uintmax_t(16) << 20;
 
 // The fixed outputs of a compile; the generated source may not take one of these names.
 constexpr const char* kOutputNames[] = {kManifestFile, kParamsFile, kSpecFile, kAssetsFile, kFatbinFile,
@@ -54,59 +54,42 @@ std::optional<std::string> source_name_problem(const std::string& name) {
 }
 
 std::optional<std::string> output_dir_problem(const fs::path& dir) {
+  if (std::optional<std::string> problem = output_dir_kind_problem(dir)) return problem;
   std::error_code ec;
-  const fs::path abs = fs::weakly_canonical(fs::absolute(dir, ec), ec);
-  if (abs.empty() || abs == abs.root_path()) return "'" + dir.string() + "' is the root directory; name a new directory";
-  if (const char* home = std::getenv("HOME"); home && *home && abs == fs::weakly_canonical(home, ec))
-    return "'" + dir.string() + "' is the home directory; name a new directory";
-  if (!fs::exists(dir, ec)) return std::nullopt;
-  if (!fs::is_directory(dir, ec)) return "'" + dir.string() + "' exists and is not a directory";
-  if (fs::is_empty(dir, ec) || fs::exists(dir / kManifestFile, ec)) return std::nullopt;
-  return "'" + dir.string() + "' is a directory that holds other files (no " + kManifestFile +
-         "); name a new or empty directory, or an earlier compile's";
-}
-
-std::optional<fs::path> make_staging_dir(const fs::path& dir, std::string* error) {
-  const fs::path abs = fs::absolute(dir).lexically_normal();
-  const fs::path parent = (abs.has_filename() ? abs : abs.parent_path()).parent_path();
-  std::error_code ec;
-  fs::create_directories(parent, ec);
-  if (ec) {
-    *error = "cannot create '" + parent.string() + "': " + ec.message();
-    return std::nullopt;
+  if (!fs::exists(dir, ec) || fs::is_empty(dir, ec)) return std::nullopt;
+  const std::string name = dir.string();
+  const std::string fix = "; kagec compile replaces its output directory whole, so name a new or empty directory";
+  // Only a directory this command wrote is replaced: a kagec manifest that lists every file in it.
+  const fs::path manifest_path = dir / kManifestFile;
+  const fs::file_status manifest_status = fs::symlink_status(manifest_path, ec);
+  if (!fs::exists(manifest_status))
+    return "'" + name + "' holds files that kagec did not write (it has no " + kManifestFile + ")" + fix;
+  const std::optional<std::string> text =
+      fs::is_regular_file(manifest_status) && fs::file_size(manifest_path, ec) <= kMaxManifestBytes
+          ? read_bytes(manifest_path)
+          : std::nullopt;
+  const Json manifest = text ? Json::parse(*text, nullptr, false) : Json();
+  const Json files = manifest.is_object() && manifest.value("kagec_manifest", 0) == 1 ? manifest.value("files", Json())
+                                                                                      : Json();
+  if (!files.is_array())
+    return "'" + (dir / kManifestFile).string() + "' is not a kagec compile manifest, so kagec did not write '" + name +
+           "'" + fix;
+  std::set<std::string> listed{kManifestFile};
+  for (const Json& f : files)
+    if (f.is_object() && f.value("name", Json()).is_string()) listed.insert(f.value("name", ""));
+  std::vector<std::string> foreign;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string entry = e.path().filename().string();
+    std::error_code st_ec;
+    if (!listed.count(entry) || !e.is_regular_file(st_ec) || e.is_symlink(st_ec)) foreign.push_back(entry);
   }
-  std::random_device rd;
-  const std::string base = (abs.has_filename() ? abs : abs.parent_path()).filename().string();
-  const fs::path staging = parent / ("." + base + ".kagec-tmp." + std::to_string(::getpid()) + "." + std::to_string(rd()));
-  if (!fs::create_directory(staging, ec) || ec) {
-    *error = "cannot create '" + staging.string() + "': " + (ec ? ec.message() : "it exists");
-    return std::nullopt;
-  }
-  return staging;
-}
-
-bool publish_staging_dir(const fs::path& staging, const fs::path& dir, std::string* error) {
-  std::error_code ec;
-  const fs::path target = fs::absolute(dir).lexically_normal();
-  const fs::path clean = target.has_filename() ? target : target.parent_path();
-  fs::path old;
-  if (fs::exists(clean, ec)) {
-    old = staging.string() + ".old";
-    fs::rename(clean, old, ec);
-    if (ec) {
-      *error = "cannot move the earlier compile '" + dir.string() + "' aside: " + ec.message();
-      return false;
-    }
-  }
-  fs::rename(staging, clean, ec);
-  if (ec) {
-    *error = "cannot move the new compile to '" + dir.string() + "': " + ec.message();
-    std::error_code back;
-    if (!old.empty()) fs::rename(old, clean, back);
-    return false;
-  }
-  if (!old.empty()) fs::remove_all(old, ec);  // a leftover costs only disk; the new compile is in place
-  return true;
+  if (ec) return "cannot list '" + name + "': " + ec.message();
+  if (foreign.empty()) return std::nullopt;
+  std::sort(foreign.begin(), foreign.end());
+  std::string more = foreign.size() > 1 ? " and " + std::to_string(foreign.size() - 1) + " more" : "";
+  return "'" + name + "' holds '" + foreign.front() + "'" + more + ", which its " + kManifestFile +
+         " does not list (kagec did not write it); move such files out of the directory, or name a new or empty "
+         "directory (kagec compile replaces its output directory whole)";
 }
 
 std::optional<std::set<std::string>> verify_compiled_files(const fs::path& dir, const Json& manifest,

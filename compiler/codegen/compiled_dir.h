@@ -32,17 +32,12 @@ inline constexpr const char* kHostLibraryFile = "kernels_host.so";
 /// outputs), or nullopt when it can.
 std::optional<std::string> source_name_problem(const std::string& name);
 
-/// Why `dir` cannot receive a compile (the root or a home directory, an existing file, a non-empty
-/// directory without a kagec manifest), or nullopt when it can.
+/// Why `dir` cannot receive a compile, or nullopt when it can: it is absent, empty, or an earlier
+/// compile, whose kagec manifest lists every entry in it (each a regular file). Anything else (the root
+/// or home directory, a symbolic link, a file, a directory holding a file kagec did not write) is left
+/// alone, since a compile replaces its directory whole (make_staging_dir, publish_staging_dir in
+/// compiler/basic/file_out.h).
 std::optional<std::string> output_dir_problem(const std::filesystem::path& dir);
-
-/// A fresh, empty directory beside `dir` to build into; nullopt with a message in `error`.
-std::optional<std::filesystem::path> make_staging_dir(const std::filesystem::path& dir, std::string* error);
-
-/// Moves the finished `staging` directory to `dir`, replacing an earlier compile there; false with a
-/// message in `error` (then `dir` still holds what it held before).
-[[nodiscard]] bool publish_staging_dir(const std::filesystem::path& staging, const std::filesystem::path& dir,
-                                       std::string* error);
 
 /// params.bin: the LatentParams words, then the VisualParams words (codegen's param_words), little-endian.
 std::string params_blob(const std::vector<uint32_t>& latent_words, const std::vector<uint32_t>& visual_words);

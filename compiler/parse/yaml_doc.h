@@ -1,9 +1,10 @@
 // YAML documents with source locations: the front end reads YAML only through here (the one other
 // user of yaml-cpp is the driver's probe of whether `kagec bench --gpu` was given a suite manifest).
 //
-// yaml-cpp accepts duplicate keys silently and gives 0-based marks; here every
-// node gets a byte Range, duplicates are reported, and plain scalars are typed
-// with the same rules as the original's loader (PyYAML safe_load, YAML 1.1).
+// yaml-cpp accepts duplicate keys silently, reads only the first of several documents, keeps merge
+// keys as plain keys and gives 0-based marks; here every node gets a byte Range, duplicates and extra
+// documents are reported, and merge keys, tags and plain scalars get the meaning the original's loader
+// (PyYAML safe_load, YAML 1.1) gives them.
 #pragma once
 
 #include <cstdint>
@@ -52,8 +53,9 @@ Scalar scalar_value(const DocNode& node);
 /// "integer", "number", "boolean", "string", "null", "list" or "mapping".
 const char* kind_name(const DocNode& node);
 
-/// Parses a buffer. Syntax errors and duplicate keys are reported; returns
-/// nullopt only when the text is not YAML at all.
+/// Parses a buffer of one YAML document. Syntax errors, duplicate keys and tags the original's loader
+/// refuses are reported; merge keys (`<<: *base`) are expanded as PyYAML's safe loader expands them.
+/// Returns nullopt when the text is not YAML at all or holds more than one document.
 std::optional<DocNode> parse_yaml(const SourceManager& sources, FileId file, DiagEngine& diags);
 
 }  // namespace kage

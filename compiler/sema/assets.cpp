@@ -22,13 +22,22 @@ namespace fs = std::filesystem;
 std::string display_path(const std::string& path) {
   fs::path p = fs::path(path).lexically_normal();
   if (p.is_absolute()) {
+    // Relative only inside the working directory: "../../x" would name the path less plainly.
     std::error_code ec;
     const fs::path rel = p.lexically_relative(fs::current_path(ec));
-    if (!ec && !rel.empty()) p = rel;
+    if (!ec && !rel.empty() && *rel.begin() != "..") p = rel;
   }
   std::string s = p.generic_string();
   if (s.size() > 1 && s.back() == '/') s.pop_back();
   return s;
+}
+
+std::optional<std::string> folder_problem(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (!fs::exists(st) || fs::is_directory(st)) return std::nullopt;
+  if (fs::is_regular_file(st)) return "is a file, not a folder; name a folder";
+  return "is not a folder (a FIFO, device or socket); name a folder";
 }
 
 namespace {
@@ -78,8 +87,13 @@ class AssetResolver {
   // different files is a warning. The Spec identifies assets by content, so either way the hash
   // does not depend on where the command ran.
   std::string locate(const std::string& base, const std::string& path, Range at, const KeySchema& k) {
+    if (fs::path(path).is_absolute()) {  // shown as written (normalised), wherever the command runs
+      std::string as_given = fs::path(path).lexically_normal().generic_string();
+      if (as_given.size() > 1 && as_given.back() == '/') as_given.pop_back();
+      return as_given;
+    }
     const std::string here = display_path(join_path(base, path));
-    if (options_.asset_root || fs::path(path).is_absolute()) return here;
+    if (options_.asset_root) return here;
     const std::string cwd = display_path(path);
     if (cwd == here) return here;
     std::error_code ec;
@@ -140,26 +154,27 @@ class AssetResolver {
 
   std::optional<AssetFile> hash_image(const std::string& file, Range at, const std::string& key) {
     if (!utf8_name(file, at, key)) return std::nullopt;
-    std::error_code ec;
-    std::ifstream in;
-    // Only regular files: a directory or a device such as /dev/zero named as an image is not one.
-    if (fs::is_regular_file(file, ec)) in.open(file, std::ios::binary);
-    if (!in.is_open() || !in) {
-      diags_.report(Rule::AssetMissing, at, "asset file '" + file + "' (from '" + key + "') does not exist; fix the path",
+    // Read only a regular file of a sane size: a directory, a FIFO or device, or a 1 GB file is
+    // refused before any byte is read, with what it is.
+    const ImageFileBytes read = read_image_file(file);
+    if (!read.ok()) {
+      diags_.report(read.kind == ImageError::kMissing || read.not_a_file ? Rule::AssetMissing : Rule::AssetUnreadable, at,
+                    "asset file '" + file + "' (from '" + key + "') " +
+                        (read.kind == ImageError::kMissing ? "does not exist; fix the path" : read.reason),
                     pointer_of(key));
       return std::nullopt;
     }
-    std::ostringstream buf;
-    buf << in.rdbuf();
-    if (in.bad()) {
-      diags_.report(Rule::AssetUnreadable, at, "asset file '" + file + "' cannot be read; check it", pointer_of(key));
+    const std::string& bytes = *read.bytes;
+    const auto* data = reinterpret_cast<const uint8_t*>(bytes.data());
+    // A header claiming more pixels than the runtime decodes says so (stb_image's own reason for
+    // some such sizes is "unknown image type").
+    if (const std::optional<std::string> too_large = header_size_problem(data, bytes.size())) {
+      diags_.report(Rule::AssetUnreadable, at, "asset file '" + file + "' cannot be decoded: " + *too_large,
+                    pointer_of(key));
       return std::nullopt;
     }
-    const std::string bytes = buf.str();
     int w = 0, h = 0, c = 0;
-    if (!stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), static_cast<int>(bytes.size()), &w, &h,
-                               &c) ||
-        w <= 0 || h <= 0) {
+    if (!stbi_info_from_memory(data, static_cast<int>(bytes.size()), &w, &h, &c) || w <= 0 || h <= 0) {
       diags_.report(Rule::AssetUnreadable, at,
                     "asset file '" + file + "' is not a readable PNG, JPEG or BMP image (" +
                         (stbi_failure_reason() ? stbi_failure_reason() : "unknown format") + "); replace it",
@@ -208,9 +223,11 @@ class AssetResolver {
       std::string bound;
       const auto found = scan_background_dir(dir.get<std::string>(), &bound);
       if (!found) {
+        const std::optional<std::string> kind = folder_problem(dir.get<std::string>());
         diags_.report(bound.empty() ? Rule::AssetMissing : Rule::AssetUnreadable, range_of(dir_key),
-                      bound.empty() ? "background folder '" + dir.get<std::string>() + "' does not exist; fix the path"
-                                    : "background folder " + bound,
+                      !bound.empty() ? "background folder " + bound
+                                     : "background folder '" + dir.get<std::string>() + "' " +
+                                           kind.value_or("does not exist; fix the path"),
                       pointer_of(dir_key));
         return;
       }
@@ -249,9 +266,11 @@ class AssetResolver {
         return;
       }
       if (!found) {
+        const std::optional<std::string> kind = folder_problem(parent.get<std::string>());
         diags_.report(Rule::AssetMissing, range_of(g.sources[0]),
-                      "sprite folder '" + parent.get<std::string>() +
-                          "' does not exist (the original would load no sprites and draw nothing); fix the path",
+                      "sprite folder '" + parent.get<std::string>() + "' " +
+                          kind.value_or("does not exist (the original would load no sprites and draw nothing); fix "
+                                        "the path"),
                       pointer_of(g.sources[0]));
         return;
       }
@@ -273,7 +292,8 @@ class AssetResolver {
       if (!utf8_name(dir, at, key)) continue;
       std::error_code ec;
       if (!fs::is_directory(dir, ec)) {
-        diags_.report(Rule::AssetMissing, at, "sprite folder '" + dir + "' does not exist; fix the path",
+        diags_.report(Rule::AssetMissing, at,
+                      "sprite folder '" + dir + "' " + folder_problem(dir).value_or("does not exist; fix the path"),
                       pointer_of(key));
         continue;
       }

@@ -17,7 +17,12 @@ namespace kage {
 void resolve_assets(const ComposedConfig& config, const Schema& schema, const ResolveOptions& options,
                     const SourceManager& sources, Spec& spec, DiagEngine& diags);
 
-/// A path relative to the working directory, lexically normalised (deterministic output).
+/// A path lexically normalised, relative to the working directory when it lies inside it (deterministic
+/// output), else as it is (never "../../x").
 std::string display_path(const std::string& path);
+
+/// What `path` is when it exists and is not a folder ("is a file, not a folder; name a folder"),
+/// else nullopt.
+std::optional<std::string> folder_problem(const std::string& path);
 
 }  // namespace kage

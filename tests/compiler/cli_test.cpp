@@ -251,3 +251,27 @@ TEST_CASE("rules lists every rule once", "[cli]") {
 }
 
 }  // namespace kage::test
+
+namespace kage::test {
+
+TEST_CASE("lint, resolve and diff --certify refuse a config of two documents at the second", "[cli][yaml]") {
+  TempDir tmp("cli_documents");
+  const std::string two = (tmp.path() / "two.yaml").string();
+  write_text(two, "extends: " + repo_path("configs/kage_bench/background/1-eval.yaml") +
+                      "\n---\nbackground: {mode: black}\n");
+  const std::string where = two + ":2:1: error: a second YAML document starts here";
+  const CliRun lint = kagec({"lint", two});
+  CHECK(lint.code == 1);
+  CHECK(lint.err.find(where) != std::string::npos);
+  CHECK(lint.err.find("[yaml-multiple-documents]") != std::string::npos);
+  const CliRun resolve = kagec({"resolve", two});
+  CHECK(resolve.code == 1);
+  CHECK(resolve.out.empty());
+  CHECK(resolve.err.find(where) != std::string::npos);
+  const CliRun certify = kagec({"diff", "--certify", "configs/kage_bench/bases/shape_black.yaml", two});
+  CHECK(certify.code == 1);
+  CHECK(certify.err.find(where) != std::string::npos);
+  CHECK(certify.out.find("certified: exactly one") == std::string::npos);
+}
+
+}  // namespace kage::test

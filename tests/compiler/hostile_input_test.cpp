@@ -114,7 +114,7 @@ TEST_CASE("control characters in file names are escaped in diagnostics", "[hosti
   std::ostringstream text;
   print_text(a.diags, text);
   INFO(text.str());
-  CHECK(text.str().find("bg\\x1b[31mred\\x0a.png") != std::string::npos);
+  CHECK(text.str().find("bg\\x1b[31mred\\n.png") != std::string::npos);
   CHECK(text.str().find('\x1b') == std::string::npos);
 }
 

@@ -3,6 +3,9 @@
 #include <catch2/catch.hpp>
 #include <stb/stb_image.h>
 
+#include <sys/resource.h>
+#include <sys/stat.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -221,4 +224,119 @@ TEST_CASE("Lanczos resize keeps flat colour, skips unchanged axes", "[lanczos]")
   const kage::Image wide = kage::resize_lanczos(pattern(20, 10, 3), 40, 10);
   CHECK(wide.width == 40);
   CHECK(int(wide.at(0, 0)[1]) == 0);
+}
+
+namespace {
+
+uint64_t peak_rss_bytes() {
+  rusage u{};
+  ::getrusage(RUSAGE_SELF, &u);
+  return uint64_t(u.ru_maxrss) * 1024;
+}
+
+void put_be(std::vector<uint8_t>& out, uint32_t v, int bytes) {
+  for (int i = bytes - 1; i >= 0; --i) out.push_back(uint8_t(v >> (8 * i)));
+}
+void put_le(std::vector<uint8_t>& out, uint32_t v, int bytes) {
+  for (int i = 0; i < bytes; ++i) out.push_back(uint8_t(v >> (8 * i)));
+}
+
+/// Headers of each format claiming `w` x `h` pixels (and nothing else of note).
+std::vector<uint8_t> png_claiming(uint32_t w, uint32_t h) {
+  std::vector<uint8_t> b = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  put_be(b, 13, 4);
+  b.insert(b.end(), {'I', 'H', 'D', 'R'});
+  put_be(b, w, 4);
+  put_be(b, h, 4);
+  b.insert(b.end(), {8, 2, 0, 0, 0, 0, 0, 0, 0});
+  put_be(b, 0, 4);
+  b.insert(b.end(), {'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82});
+  return b;
+}
+std::vector<uint8_t> bmp_claiming(uint32_t w, uint32_t h) {
+  std::vector<uint8_t> b = {'B', 'M'};
+  put_le(b, 54, 4);
+  put_le(b, 0, 4);
+  put_le(b, 54, 4);
+  put_le(b, 40, 4);
+  put_le(b, w, 4);
+  put_le(b, uint32_t(-int32_t(h)), 4);  // top-down
+  put_le(b, 1, 2);
+  put_le(b, 24, 2);
+  b.resize(54, 0);
+  return b;
+}
+std::vector<uint8_t> gif_claiming(uint16_t w, uint16_t h) {
+  std::vector<uint8_t> b = {'G', 'I', 'F', '8', '9', 'a'};
+  put_le(b, w, 2);
+  put_le(b, h, 2);
+  b.insert(b.end(), {0, 0, 0, ';'});
+  return b;
+}
+std::vector<uint8_t> jpeg_claiming(uint16_t w, uint16_t h) {
+  std::vector<uint8_t> b = {0xFF, 0xD8, 0xFF, 0xE0};  // SOI, then an APP0 segment before the frame
+  put_be(b, 16, 2);
+  b.insert(b.end(), {'J', 'F', 'I', 'F', 0, 1, 1, 0, 0, 1, 0, 1, 0, 0});
+  b.insert(b.end(), {0xFF, 0xC0});
+  put_be(b, 17, 2);
+  b.push_back(8);
+  put_be(b, h, 2);
+  put_be(b, w, 2);
+  b.insert(b.end(), {3, 1, 0x11, 0, 2, 0x11, 1, 3, 0x11, 1, 0xFF, 0xD9});
+  return b;
+}
+
+}  // namespace
+
+TEST_CASE("load_image says what a path is that is no image file, before reading it", "[image_io][hostile]") {
+  const std::string dir = temp_dir();
+  const std::string fifo = dir + "/pipe.png";
+  std::remove(fifo.c_str());
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  kage::ImageResult r = kage::load_image(fifo, 3);  // opened without blocking: no writer, no hang
+  CHECK(r.kind == kage::ImageError::kUnreadable);
+  CHECK(r.error == fifo + ": is not a regular file (a FIFO, device or socket); name an image file");
+  r = kage::load_image("/dev/zero", 3);
+  CHECK(r.error == "/dev/zero: is not a regular file (a FIFO, device or socket); name an image file");
+  r = kage::load_image(dir, 3);
+  CHECK(r.kind == kage::ImageError::kUnreadable);
+  CHECK(r.error == dir + ": is a directory, not an image file; name an image file");
+  std::remove(fifo.c_str());
+
+  const std::string big = dir + "/big.png";
+  write_bytes(big, png_claiming(64, 64));
+  fs::resize_file(big, uint64_t(1) << 30);  // sparse
+  const uint64_t rss = peak_rss_bytes();
+  r = kage::load_image(big, 3);
+  CHECK(r.kind == kage::ImageError::kTooLarge);
+  CHECK(r.error == big + ": is 1073741824 bytes, more than an image file may be (256 MiB); use a smaller image");
+  CHECK(peak_rss_bytes() < rss + (uint64_t(256) << 20));  // not read
+  fs::remove(big);
+}
+
+TEST_CASE("a header claiming a huge image is too large, in every format", "[image_io][hostile]") {
+  struct Case {
+    const char* name;
+    std::vector<uint8_t> bytes;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"png", png_claiming(50000, 50000), "image too large: 50000x50000 pixels"},
+      {"png_wide", png_claiming(1u << 31, 1), "image too large: 2147483648x1 pixels"},
+      {"bmp", bmp_claiming(30000, 30000), "image too large: 30000x30000 pixels"},
+      {"gif", gif_claiming(65535, 65535), "image too large: 65535x65535 pixels"},
+      {"jpeg", jpeg_claiming(60000, 60000), "image too large: 60000x60000 pixels"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.name);
+    const std::string path = temp_dir() + "/claims_" + c.name;
+    write_bytes(path, c.bytes);
+    const kage::ImageResult r = kage::load_image(path, 3);
+    CHECK(r.kind == kage::ImageError::kTooLarge);
+    CHECK(r.error == path + ": " + c.says + ", more than 16777216 (4096x4096); use a smaller image");
+  }
+  // 4096 x 4096 is allowed: the header check passes it on to the decoder.
+  const std::string ok = temp_dir() + "/claims_ok.png";
+  write_bytes(ok, png_claiming(4096, 4096));
+  CHECK(kage::load_image(ok, 3).kind == kage::ImageError::kCorrupt);
 }

@@ -173,14 +173,16 @@ def augment_draws(random, stream: int, counter: torch.Tensor, position: int) -> 
 def augment_frames(fn: Callable, reference: str, frames: torch.Tensor, uniform: Callable,
                    images: Optional[torch.Tensor] = None) -> torch.Tensor:
     """fn on `frames` (at `images` where given: see the contract above), its output checked: uint8 frames of the
-    input's shape on its device."""
-    if images is not None and getattr(fn, "takes_frame_indices", False) is True:
-        out = fn(frames, uniform, images=images)
-        expected = (*images.shape, *frames.shape[-3:])
-    else:
-        frames = frames if images is None else frames.reshape(-1, *frames.shape[-3:])[images]
-        out = fn(frames, uniform)
-        expected = tuple(frames.shape)
+    input's shape on its device. Outside any autocast (a truncation's bootstrap runs under --bf16's), so that its
+    parameters are the same float32 numbers wherever it is called."""
+    with torch.autocast(frames.device.type, enabled=False):
+        if images is not None and getattr(fn, "takes_frame_indices", False) is True:
+            out = fn(frames, uniform, images=images)
+            expected = (*images.shape, *frames.shape[-3:])
+        else:
+            frames = frames if images is None else frames.reshape(-1, *frames.shape[-3:])[images]
+            out = fn(frames, uniform)
+            expected = tuple(frames.shape)
     problem = augmented_problem(out, expected, frames.device)
     if problem:
         raise SystemExit(f"kage.ppo.train: --augment {reference}: {problem}")
