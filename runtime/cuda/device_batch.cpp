@@ -2,6 +2,7 @@
 #include "runtime/cuda/device_batch.h"
 
 #include <algorithm>
+#include <climits>
 #include <cstddef>
 #include <cstring>
 #include <vector>
@@ -156,6 +157,63 @@ std::optional<DeviceAssets> upload_assets(const AssetView& ha, std::string* erro
   return d;
 }
 
+namespace {
+
+/// The columns of `a` from environment `first` on.
+InfoArrays offset_info(const InfoArrays& a, int32_t first) {
+  InfoArrays o{};
+#define KAGE_INFO_FIELD(Enum, member, name, ctype, dtype, doc, value) o.member = a.member + first;
+#include "runtime/info_fields.def"
+#undef KAGE_INFO_FIELD
+  return o;
+}
+
+/// The view of environments [first, first + count) of the batch view `w`: every per-env pointer moved
+/// to environment `first` (layouts `segment_stride` bytes apart, frames `frame_bytes`).
+DeviceEnvs part_view(const DeviceEnvs& w, int32_t first, int32_t count, size_t frame_bytes) {
+  const int64_t f = first;
+  DeviceEnvs v = w;
+  v.num_envs = count;
+  v.seeds = w.seeds + f;
+  v.latent = w.latent + f;
+  v.segments = w.segments + f * w.segment_stride;
+  v.visual = w.visual + f;
+  v.actions.data = static_cast<const int32_t*>(w.actions.data) + f;
+  v.reset_mask = nullptr;
+  v.obs = w.obs + f * static_cast<int64_t>(frame_bytes);
+  v.reward = w.reward + f;
+  v.terminated = w.terminated + f;
+  v.truncated = w.truncated + f;
+  v.info = offset_info(w.info, first);
+  v.final_mask = w.final_mask + f;
+  v.final_latent = w.final_latent + f;
+  v.final_segments = w.final_segments + f * w.segment_stride;
+  v.final_visual = w.final_visual + f;
+  v.final_obs = w.final_obs + f * static_cast<int64_t>(frame_bytes);
+  v.final_info = offset_info(w.final_info, first);
+  return v;
+}
+
+/// Why a part cannot run on the GPU, or cannot join the first part `p0` in one batch; empty if it can.
+std::string part_problem(const DevicePartSource& p, const DevicePartSource& p0) {
+  if (!p.module) return "no module";
+  if (p.num_envs < 0) return "a negative environment count";
+  if (!latent_params_supported(p.lp)) return "layout parameters not supported";
+  if (!render_supported(p.vp))
+    return "frame size not supported on the GPU (W <= " + std::to_string(kMaxScreenWidth) +
+           "; with blur, sharpen or pixelate H * W <= " + std::to_string(kFramePassMaxThreads * kFramePassPixelsPerThread) +
+           ")";
+  if (layout_segment_count(p.lp) != layout_segment_count(p0.lp))
+    return "its layout has " + std::to_string(layout_segment_count(p.lp)) + " segments, the first part's " +
+           std::to_string(layout_segment_count(p0.lp)) + ": the parts of one batch must share one hidden game";
+  if (p.vp.H != p0.vp.H || p.vp.W != p0.vp.W)
+    return "its frames are " + std::to_string(p.vp.H) + "x" + std::to_string(p.vp.W) + ", the first part's " +
+           std::to_string(p0.vp.H) + "x" + std::to_string(p0.vp.W) + ": the parts of one batch must share one frame size";
+  return {};
+}
+
+}  // namespace
+
 std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const LatentParams& lp,
                                                const VisualParams& vp, const AssetView& host_assets, int32_t num_envs,
                                                std::string* error) {
@@ -163,62 +221,94 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
     *error = "DeviceBatch: the environment count must be positive";
     return std::nullopt;
   }
-  if (!latent_params_supported(lp)) {
-    *error = "DeviceBatch: layout parameters not supported";
+  return create({DevicePartSource{&module, lp, vp, host_assets, num_envs}}, error);
+}
+
+std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSource>& parts, std::string* error) {
+  int64_t total = 0;
+  for (const DevicePartSource& p : parts) total += std::max(p.num_envs, 0);
+  if (parts.empty() || total <= 0 || total > INT32_MAX) {
+    *error = "DeviceBatch: give one or more parts with 1 to 2^31 - 1 environments in all";
     return std::nullopt;
   }
-  if (!render_supported(vp)) {
-    *error = "DeviceBatch: frame size not supported on the GPU (W <= " + std::to_string(kMaxScreenWidth) +
-             "; with blur, sharpen or pixelate H * W <= " + std::to_string(kFramePassMaxThreads * kFramePassPixelsPerThread) + ")";
-    return std::nullopt;
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const std::string problem = part_problem(parts[k], parts.front());
+    if (!problem.empty()) {
+      *error = "DeviceBatch: " + (parts.size() > 1 ? "part " + std::to_string(k) + ": " : std::string()) + problem;
+      return std::nullopt;
+    }
+    // A generic module holds its parameters in its __constant__ memory: one instance serves one part.
+    size_t bytes = 0;
+    for (size_t j = 0; j < k; ++j)
+      if (parts[j].module == parts[k].module && parts[k].module->global("kage_dynamic_latent", &bytes) != 0) {
+        *error = "DeviceBatch: parts " + std::to_string(j) + " and " + std::to_string(k) +
+                 " share one module whose parameters are in its __constant__ memory: load one module per part";
+        return std::nullopt;
+      }
   }
-  DeviceBatch b;
-  for (auto [fn, name] : {std::pair{&b.reset_, "kage_reset"}, std::pair{&b.step_, "kage_step"}, std::pair{&b.render_, "kage_render"},
-                          std::pair{&b.sample_actions_, "kage_sample_actions"}}) {
-    *fn = module.function(name, error);
-    if (!*fn) return std::nullopt;
-  }
-  if (!upload_dynamic_params(module, lp, vp, error)) return std::nullopt;
-  b.render_threads_ = render_threads(vp);
-  b.render_smem_ = render_dynamic_smem_bytes(vp);
   CUdevice dev;
   int multiprocessors = 0;
   if (!check(cuCtxGetDevice(&dev), "cuCtxGetDevice", error) ||
       !check(cuDeviceGetAttribute(&multiprocessors, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, dev),
              "cuDeviceGetAttribute(multiprocessors)", error))
     return std::nullopt;
-  b.frames_per_block_ = frames_per_block(vp, num_envs, multiprocessors);
-  if (!check(cuFuncSetAttribute(b.render_, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, b.render_smem_),
-             "cuFuncSetAttribute(dynamic shared memory)", error))
-    return std::nullopt;
 
-  std::optional<DeviceAssets> assets = upload_assets(host_assets, error);
-  if (!assets) return std::nullopt;
-  b.assets_ = assets->memory;
-  b.envs_.assets = assets->view;
-  const AssetView& ha = host_assets;
+  // Each part: its kernels, its parameters in its module, its launch settings and its assets. A part is
+  // kept in the batch as soon as it owns device memory, so that the batch's destructor frees it on error.
+  DeviceBatch b;
+  int32_t first = 0;
+  int32_t visual_extent = 0;
+  for (const DevicePartSource& src : parts) {
+    Part p;
+    p.first = first;
+    for (auto [fn, name] : {std::pair{&p.reset, "kage_reset"}, std::pair{&p.step, "kage_step"}, std::pair{&p.render, "kage_render"}}) {
+      *fn = src.module->function(name, error);
+      if (!*fn) return std::nullopt;
+    }
+    if (!b.sample_actions_ && !(b.sample_actions_ = src.module->function("kage_sample_actions", error)))
+      return std::nullopt;
+    if (!upload_dynamic_params(*src.module, src.lp, src.vp, error)) return std::nullopt;
+    p.render_threads = render_threads(src.vp);
+    p.render_smem = render_dynamic_smem_bytes(src.vp);
+    p.frames_per_block = frames_per_block(src.vp, std::max(src.num_envs, 1), multiprocessors);
+    if (!check(cuFuncSetAttribute(p.render, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, p.render_smem),
+               "cuFuncSetAttribute(dynamic shared memory)", error))
+      return std::nullopt;
+    std::optional<DeviceAssets> assets = upload_assets(src.host_assets, error);
+    if (!assets) return std::nullopt;
+    p.assets = assets->memory;
+    p.envs.assets = assets->view;
+    p.envs.num_envs = src.num_envs;
+    p.envs.visual_extent = visual_state_extent(src.vp, src.host_assets);
+    visual_extent = std::max(visual_extent, p.envs.visual_extent);
+    b.parts_.push_back(p);
+    first += src.num_envs;
+  }
 
-  // State and observations.
-  const size_t n = static_cast<size_t>(num_envs);
-  b.segment_count_ = layout_segment_count(lp);
+  // State and observations: one allocation each for every environment of every part.
+  const DevicePartSource& p0 = parts.front();
+  const size_t n = static_cast<size_t>(total);
+  b.segment_count_ = layout_segment_count(p0.lp);
   const int32_t stride = segment_stride_bytes(b.segment_count_);
   const StateLayout l = state_layout(n, static_cast<size_t>(stride));
-  b.obs_stride_ = static_cast<size_t>(vp.H) * vp.W * 3;
+  b.obs_stride_ = static_cast<size_t>(p0.vp.H) * p0.vp.W * 3;
   if (!check(cuMemAlloc(&b.state_, l.total), "cuMemAlloc(state)", error)) return std::nullopt;
   if (!check(cuMemsetD8(b.state_, 0, l.total), "cuMemsetD8(state)", error)) return std::nullopt;
   if (!check(cuMemAlloc(&b.obs_buf_, 2 * n * b.obs_stride_), "cuMemAlloc(observations)", error)) return std::nullopt;
+  // One host-mapped report slot per part: a part's kernels number its environments from 0.
   void* mapped = nullptr;
   CUdeviceptr mapped_device = 0;
-  if (!check(cuMemHostAlloc(&mapped, sizeof(ActionError), CU_MEMHOSTALLOC_DEVICEMAP), "cuMemHostAlloc", error) ||
-      !check(cuMemHostGetDevicePointer(&mapped_device, mapped, 0), "cuMemHostGetDevicePointer", error))
-    return std::nullopt;
+  const size_t report_bytes = parts.size() * sizeof(ActionError);
+  if (!check(cuMemHostAlloc(&mapped, report_bytes, CU_MEMHOSTALLOC_DEVICEMAP), "cuMemHostAlloc", error)) return std::nullopt;
   b.action_error_ = static_cast<ActionError*>(mapped);
-  *b.action_error_ = ActionError{};
+  for (size_t k = 0; k < parts.size(); ++k) b.action_error_[k] = ActionError{};
+  if (!check(cuMemHostGetDevicePointer(&mapped_device, mapped, 0), "cuMemHostGetDevicePointer", error))
+    return std::nullopt;
   auto ptr = [&](size_t off) { return reinterpret_cast<uint8_t*>(b.state_ + off); };
   DeviceEnvs& e = b.envs_;
-  e.num_envs = num_envs;
+  e.num_envs = static_cast<int32_t>(total);
   e.segment_stride = stride;
-  e.visual_extent = visual_state_extent(vp, ha);
+  e.visual_extent = visual_extent;
   e.seeds = reinterpret_cast<const uint64_t*>(ptr(l.seeds));
   e.latent = reinterpret_cast<LatentState*>(ptr(l.latent));
   e.segments = ptr(l.segments);
@@ -236,6 +326,16 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
   e.final_visual = reinterpret_cast<VisualState*>(ptr(l.final_visual));
   e.final_obs = reinterpret_cast<uint8_t*>(b.obs_buf_ + n * b.obs_stride_);
   e.final_info = info_arrays(b.state_, l.final_info);
+  e.assets = b.parts_.front().envs.assets;
+  for (size_t k = 0; k < b.parts_.size(); ++k) {
+    Part& p = b.parts_[k];
+    const AssetView assets = p.envs.assets;
+    const int32_t extent = p.envs.visual_extent;
+    p.envs = part_view(e, p.first, p.envs.num_envs, b.obs_stride_);
+    p.envs.assets = assets;
+    p.envs.visual_extent = extent;
+    p.envs.actions.error = reinterpret_cast<ActionError*>(mapped_device) + k;
+  }
   b.reset_mask_ = ptr(l.reset_mask);
   b.seeds_.assign(n, 0);
   return b;
@@ -243,46 +343,53 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
 
 DeviceBatch::DeviceBatch(DeviceBatch&& o) noexcept
     : envs_(o.envs_),
+      parts_(std::move(o.parts_)),
       stream_(o.stream_),
       obs_stride_(o.obs_stride_),
       segment_count_(o.segment_count_),
-      render_threads_(o.render_threads_),
-      render_smem_(o.render_smem_),
-      frames_per_block_(o.frames_per_block_),
       steps_(o.steps_),
       state_(o.state_),
       obs_buf_(o.obs_buf_),
-      assets_(o.assets_),
       reset_mask_(o.reset_mask_),
       seeds_(std::move(o.seeds_)),
       action_error_(o.action_error_),
-      reset_(o.reset_),
-      step_(o.step_),
-      render_(o.render_),
       sample_actions_(o.sample_actions_) {
-  o.state_ = o.obs_buf_ = o.assets_ = 0;
+  o.parts_.clear();
+  o.state_ = o.obs_buf_ = 0;
   o.action_error_ = nullptr;
 }
 
 DeviceBatch::~DeviceBatch() {
   // Frees fail only once the context is gone at exit, when the memory is released anyway.
-  for (CUdeviceptr p : {state_, obs_buf_, assets_})
+  for (CUdeviceptr p : {state_, obs_buf_})
     if (p) cuMemFree(p);
+  for (const Part& p : parts_)
+    if (p.assets) cuMemFree(p.assets);
   if (action_error_) cuMemFreeHost(action_error_);
 }
 
-bool DeviceBatch::launch_per_env(CUfunction f, std::string* error) {
-  void* args[] = {&envs_};
-  const unsigned grid = static_cast<unsigned>((envs_.num_envs + kPerEnvThreads - 1) / kPerEnvThreads);
+bool DeviceBatch::launch_per_env(CUfunction f, const DeviceEnvs& envs, std::string* error) {
+  if (envs.num_envs == 0) return true;  // a mixture's part of no environments
+  DeviceEnvs arg = envs;
+  void* args[] = {&arg};
+  const unsigned grid = static_cast<unsigned>((envs.num_envs + kPerEnvThreads - 1) / kPerEnvThreads);
   return check(cuLaunchKernel(f, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream_, args, nullptr), "cuLaunchKernel", error);
 }
 
-bool DeviceBatch::launch_render(std::string* error) {
-  void* args[] = {&envs_};
-  const unsigned grid = static_cast<unsigned>((envs_.num_envs + frames_per_block_ - 1) / frames_per_block_);
-  return check(cuLaunchKernel(render_, grid, 1, 1, static_cast<unsigned>(render_threads_),
-                              1, 1, static_cast<unsigned>(render_smem_), stream_, args, nullptr),
+bool DeviceBatch::launch_render(const Part& p, std::string* error) {
+  if (p.envs.num_envs == 0) return true;
+  DeviceEnvs arg = p.envs;
+  void* args[] = {&arg};
+  const unsigned grid = static_cast<unsigned>((p.envs.num_envs + p.frames_per_block - 1) / p.frames_per_block);
+  return check(cuLaunchKernel(p.render, grid, 1, 1, static_cast<unsigned>(p.render_threads),
+                              1, 1, static_cast<unsigned>(p.render_smem), stream_, args, nullptr),
                "cuLaunchKernel", error);
+}
+
+bool DeviceBatch::launch_renders(std::string* error) {
+  for (const Part& p : parts_)
+    if (!launch_render(p, error)) return false;
+  return true;
 }
 
 bool DeviceBatch::reset(const uint64_t* seeds, const uint8_t* mask, std::string* error) {
@@ -296,20 +403,26 @@ bool DeviceBatch::reset(const uint64_t* seeds, const uint8_t* mask, std::string*
   if (mask && !check(cuMemcpyHtoDAsync(reinterpret_cast<CUdeviceptr>(reset_mask_), mask, n, stream_),
                      "cuMemcpyHtoDAsync(reset mask)", error))
     return false;
-  envs_.reset_mask = mask ? reset_mask_ : nullptr;
-  const bool ok = launch_per_env(reset_, error);
-  envs_.reset_mask = nullptr;
-  return ok && launch_render(error);
+  for (const Part& p : parts_) {
+    DeviceEnvs v = p.envs;
+    v.reset_mask = mask ? reset_mask_ + p.first : nullptr;
+    if (!launch_per_env(p.reset, v, error)) return false;
+  }
+  return launch_renders(error);
 }
 
 bool DeviceBatch::launch_step(const ActionSource& source, bool render, std::string* error) {
-  const ActionSource own = envs_.actions;
-  envs_.actions = source;
-  envs_.actions.step = ++steps_;
-  envs_.actions.error = own.error;
-  const bool ok = launch_per_env(step_, error);
-  envs_.actions = own;
-  return ok && (!render || launch_render(error));
+  const uint64_t step = ++steps_;
+  const int64_t element = source.is_int64 ? sizeof(int64_t) : sizeof(int32_t);
+  for (const Part& p : parts_) {
+    DeviceEnvs v = p.envs;
+    v.actions = source;
+    v.actions.data = static_cast<const uint8_t*>(source.data) + p.first * source.stride * element;
+    v.actions.step = step;
+    v.actions.error = p.envs.actions.error;
+    if (!launch_per_env(p.step, v, error)) return false;
+  }
+  return !render || launch_renders(error);
 }
 
 bool DeviceBatch::step(const int32_t* actions, std::string* error) {
@@ -328,11 +441,17 @@ bool DeviceBatch::step_device_actions(std::string* error) { return launch_step(e
 bool DeviceBatch::step_no_render(std::string* error) { return launch_step(envs_.actions, false, error); }
 
 std::optional<ActionError> DeviceBatch::take_action_error() {
-  volatile ActionError* e = action_error_;
-  if (e->state != 2u) return std::nullopt;
-  const ActionError reported{2u, e->env, e->value, e->step};
-  e->state = 0u;
-  return reported;
+  // The earliest step's report (the first part's among those of one step), with the part's first
+  // environment added; the other complete reports are forgotten with it, as one part's later ones are.
+  std::optional<ActionError> first;
+  for (size_t k = 0; k < parts_.size(); ++k) {
+    volatile ActionError* e = action_error_ + k;
+    if (e->state != 2u) continue;
+    const ActionError reported{2u, e->env + parts_[k].first, e->value, e->step};
+    e->state = 0u;
+    if (!first || reported.step < first->step) first = reported;
+  }
+  return first;
 }
 
 bool DeviceBatch::synchronize(std::string* error) const {
@@ -434,7 +553,7 @@ bool DeviceBatch::load_state(const uint8_t* data, size_t size, const std::string
   // read pageable host memory, so they are complete when this returns.
   return check(cuMemsetD8Async(reinterpret_cast<CUdeviceptr>(envs_.final_mask), 0, n, stream_),
                "cuMemsetD8Async(final mask)", error) &&
-         launch_render(error) && synchronize(error);
+         launch_renders(error) && synchronize(error);
 }
 
 }  // namespace kage

@@ -1,5 +1,7 @@
 // GPU batch runtime: N environments of one compiled config in device memory, stepped and rendered by
-// the kernels of a loaded module (kernels.cuh entry points). Observations stay on the device.
+// the kernels of a loaded module (kernels.cuh entry points), or of several configs (a mixture): one part
+// per config, each running its own module's kernels on its rows of the one set of buffers. Observations
+// stay on the device.
 //
 // Every launch and copy goes to one CUDA stream (set_stream; the legacy default stream unless set), in
 // call order, so a consumer on that stream needs no synchronisation. Nothing here waits for the device
@@ -46,6 +48,17 @@ struct DeviceActions {
   bool is_int64 = false;
 };
 
+/// One config of a batch: `num_envs` environments running `module`'s kernels with these parameters
+/// (uploaded to the module's __constant__ parameters when it has them, so two parts never share a module
+/// instance). `host_assets` points to host memory; it is copied to the device.
+struct DevicePartSource {
+  const CudaModule* module = nullptr;  ///< must outlive the batch
+  LatentParams lp{};
+  VisualParams vp{};
+  AssetView host_assets{};
+  int32_t num_envs = 0;
+};
+
 class DeviceBatch {
  public:
   /// A batch of `num_envs` environments running `module`'s kernels with these parameters (uploaded to
@@ -53,6 +66,12 @@ class DeviceBatch {
   /// host memory; it is copied to the device. Nothing on error, with the reason in `error`.
   static std::optional<DeviceBatch> create(const CudaModule& module, const LatentParams& lp, const VisualParams& vp,
                                            const AssetView& host_assets, int32_t num_envs, std::string* error);
+  /// A batch of several parts (a mixture), numbered part by part: the first part's environments first.
+  /// One allocation of per-environment state and one of observations for all of them; each part's
+  /// kernels see only its own rows (a DeviceEnvs whose pointers start at its first environment), so
+  /// environment i equals environment i - first of its config run alone. The parts must share the layout
+  /// segment count (one hidden game) and the frame size. Nothing on error, with the reason in `error`.
+  static std::optional<DeviceBatch> create(const std::vector<DevicePartSource>& parts, std::string* error);
 
   DeviceBatch(DeviceBatch&& other) noexcept;
   DeviceBatch& operator=(DeviceBatch&&) = delete;
@@ -76,10 +95,12 @@ class DeviceBatch {
   bool step_device_actions(std::string* error);
   /// One step without rendering (observations are left as they were).
   bool step_no_render(std::string* error);
-  /// Fills actions() with uniform random actions in [0, 8) for step t, on the device.
+  /// Fills actions() (every environment of every part) with uniform random actions in [0, 8) for step t,
+  /// on the device.
   bool sample_actions(uint64_t seed, uint32_t t, std::string* error);
-  /// The first out-of-range device action a finished step reported (none if none), then forgets it.
-  /// Reads host-mapped memory: no synchronisation, so a report arrives once its step has run.
+  /// The first out-of-range device action a finished step reported (none if none; `env` is the batch's
+  /// index), then forgets it. Reads host-mapped memory: no synchronisation, so a report arrives once its
+  /// step has run.
   std::optional<ActionError> take_action_error();
 
   int32_t size() const { return envs_.num_envs; }
@@ -96,45 +117,61 @@ class DeviceBatch {
   CUdeviceptr final_obs() const { return reinterpret_cast<CUdeviceptr>(envs_.final_obs); }
   /// Copies every observation into host memory (size() * obs_bytes_per_env() bytes); synchronises.
   bool download_obs(uint8_t* host, std::string* error) const;
-  /// The device view the kernels get (latent, layout and visual state pointers included).
+  /// The device view of the whole batch (latent, layout and visual state pointers included); its assets
+  /// are the first part's. A batch of one part launches its kernels on this very view.
   const DeviceEnvs& envs() const { return envs_; }
+  /// The number of parts (1 unless a mixture), and each part's first environment and count.
+  int32_t part_count() const { return static_cast<int32_t>(parts_.size()); }
+  int32_t part_first(int32_t part) const { return parts_[static_cast<size_t>(part)].first; }
+  int32_t part_size(int32_t part) const { return parts_[static_cast<size_t>(part)].envs.num_envs; }
   size_t obs_bytes_per_env() const { return obs_stride_; }
   int32_t segment_bytes() const { return segment_count_; }
 
   /// The saved state (runtime/cpu/batch_state.h) under `spec_hash`; synchronises.
   bool save_state(const std::string& spec_hash, std::vector<uint8_t>* out, std::string* error) const;
-  /// Restores a saved state and renders its observations.
+  /// Restores a saved state and renders its observations (each part with its own kernels).
   bool load_state(const uint8_t* data, size_t size, const std::string& spec_hash, std::string* error);
   /// Waits until every launch and copy of this batch has finished.
   bool synchronize(std::string* error) const;
 
  private:
+  /// One config's environments [first, first + envs.num_envs): its kernels, its render launch and its
+  /// view of the batch's buffers.
+  struct Part {
+    int32_t first = 0;
+    DeviceEnvs envs{};  ///< every per-env pointer offset by `first`; assets the part's own
+    CUfunction reset = nullptr;
+    CUfunction step = nullptr;
+    CUfunction render = nullptr;
+    int32_t render_threads = 0;
+    int32_t render_smem = 0;
+    int32_t frames_per_block = 1;
+    CUdeviceptr assets = 0;  ///< owned
+  };
+
   DeviceBatch() = default;
-  bool launch_per_env(CUfunction f, std::string* error);
-  /// Launches the render kernel: frames_per_block_ environments per block.
-  bool launch_render(std::string* error);
+  bool launch_per_env(CUfunction f, const DeviceEnvs& envs, std::string* error);
+  /// Launches a part's render kernel: frames_per_block environments per block.
+  bool launch_render(const Part& p, std::string* error);
+  /// Every part's render, in part order.
+  bool launch_renders(std::string* error);
+  /// One step of every part reading `source` (element env * stride, env the batch's index), then renders.
   bool launch_step(const ActionSource& source, bool render, std::string* error);
   /// Queues the copies between the saved-state sections of `blob` and the device (to_host: download).
   bool copy_state(uint8_t* blob, bool to_host, std::string* error) const;
 
   DeviceEnvs envs_{};
+  std::vector<Part> parts_;
   CUstream stream_ = nullptr;
   size_t obs_stride_ = 0;
   int32_t segment_count_ = 0;
-  int32_t render_threads_ = 0;
-  int32_t render_smem_ = 0;
-  int32_t frames_per_block_ = 1;
   uint64_t steps_ = 0;       ///< steps launched, reported with an out-of-range action
   CUdeviceptr state_ = 0;    ///< one allocation for every per-env array but the observations
   CUdeviceptr obs_buf_ = 0;  ///< observations, then final observations
-  CUdeviceptr assets_ = 0;
   uint8_t* reset_mask_ = nullptr;        ///< device buffer for a reset's mask
   std::vector<uint64_t> seeds_;          ///< host copy of the device seeds
-  ActionError* action_error_ = nullptr;  ///< host-mapped
-  CUfunction reset_ = nullptr;
-  CUfunction step_ = nullptr;
-  CUfunction render_ = nullptr;
-  CUfunction sample_actions_ = nullptr;
+  ActionError* action_error_ = nullptr;  ///< host-mapped, one per part (its env is the part's index)
+  CUfunction sample_actions_ = nullptr;  ///< the first part's (every module's is the same code)
 };
 
 }  // namespace kage
