@@ -254,9 +254,10 @@ std::unique_ptr<Env> open_compiled_cpu(const CompiledDir& c, const Options& o, s
 /// GPU over runtime/cuda: a fatbin, or NVRTC on the generated source.
 class GpuEnv final : public Env {
  public:
-  GpuEnv(CUcontext ctx, CudaModule m, DeviceBatch b, AssetPack pack, int32_t H, int32_t W, std::string hash,
-         CUdeviceptr config_index)
-      : ctx_(ctx), module_(std::move(m)), pack_(std::move(pack)), batch_(std::move(b)), H_(H), W_(W),
+  /// `modules` and `packs`: one per part of `b` (a mixture has several), kept as long as the batch runs.
+  GpuEnv(CUcontext ctx, std::vector<CudaModule> modules, DeviceBatch b, std::vector<AssetPack> packs, int32_t H,
+         int32_t W, std::string hash, CUdeviceptr config_index)
+      : ctx_(ctx), modules_(std::move(modules)), packs_(std::move(packs)), batch_(std::move(b)), H_(H), W_(W),
         hash_(std::move(hash)), config_index_(config_index) {}
   // The members free device memory: in this batch's context, whichever thread drops the last reference,
   // once the device has run all queued work (this batch's launches, and a consumer's kernels on its own
@@ -344,42 +345,81 @@ class GpuEnv final : public Env {
 
   bool started_ = false;  // a reset or load_state has run
   CUcontext ctx_;
-  CudaModule module_;
-  AssetPack pack_;
+  std::vector<CudaModule> modules_;  ///< the kernels of each part, unloaded after the batch is freed
+  std::vector<AssetPack> packs_;
   DeviceBatch batch_;
   int32_t H_, W_;
   std::string hash_;
-  CUdeviceptr config_index_;  ///< [N] int32 zeros: one config
+  CUdeviceptr config_index_;  ///< [N] int32: each environment's part (zeros for one config)
   std::vector<int32_t> actions_;
 };
 
-std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const std::string& fatbin, AssetPack pack,
-                              const Options& o, std::string* error, ErrorKind* kind) {
+/// The module of one config: its fatbin when given, else NVRTC on its generated `source` (through the
+/// kernel cache). Each call loads a module of its own, with its own __constant__ parameters.
+std::optional<CudaModule> gpu_module(const std::string& spec_hash, const std::string& source, const std::string& fatbin,
+                                     std::string* error) {
+  if (!fatbin.empty()) return CudaModule::load_file(fatbin, error);
+  NvrtcOptions no;
+  no.include_dir = runtime_include_dir();
+  no.generator_version = std::to_string(kCodegenVersion);
+  return CudaModule::compile(source, "kage_" + spec_hash.substr(0, 16) + ".cu", no, error);
+}
+
+/// One config of a GPU batch: its Spec hash, lowered parameters, module source (or fatbin), assets and
+/// environment count.
+struct GpuEnvPart {
+  const Loaded* loaded;
+  std::string source;
+  std::string fatbin;
+  AssetPack pack;
+  int32_t num_envs;
+};
+
+/// A GpuEnv over one DeviceBatch of `parts` (a mixture when several), under `hash`; config_index() holds
+/// each environment's part.
+std::unique_ptr<Env> open_gpu_parts(std::vector<GpuEnvPart> parts, const std::string& hash, const Options& o,
+                                    std::string* error, ErrorKind* kind) {
   const CUcontext ctx = cuda_primary_context(error);
   if (!ctx) return *kind = ErrorKind::kDevice, nullptr;
-  std::optional<CudaModule> m;
-  if (!fatbin.empty()) {
-    m = CudaModule::load_file(fatbin, error);
-  } else {
-    NvrtcOptions no;
-    no.include_dir = runtime_include_dir();
-    no.generator_version = std::to_string(kCodegenVersion);
-    m = CudaModule::compile(source, "kage_" + l.spec_hash.substr(0, 16) + ".cu", no, error);
+  // Every module first: the parts point at them, and a vector that grows moves its elements.
+  std::vector<CudaModule> modules;
+  for (const GpuEnvPart& p : parts) {
+    std::optional<CudaModule> m = gpu_module(p.loaded->spec_hash, p.source, p.fatbin, error);
+    if (!m) return nullptr;
+    modules.push_back(std::move(*m));
   }
-  if (!m) return nullptr;
-  auto b = DeviceBatch::create(*m, l.config.latent, l.config.visual, pack.view(), o.num_envs, error);
+  std::vector<DevicePartSource> sources;
+  int64_t total = 0;
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const LoweredConfig& c = parts[k].loaded->config;
+    sources.push_back(DevicePartSource{&modules[k], c.latent, c.visual, parts[k].pack.view(), parts[k].num_envs});
+    total += parts[k].num_envs;
+  }
+  auto b = DeviceBatch::create(sources, error);
   if (!b) return nullptr;
   b->set_stream(static_cast<CUstream>(o.stream));
-  const size_t index_bytes = static_cast<size_t>(o.num_envs) * sizeof(int32_t);
   CUdeviceptr config_index = 0;
-  CUresult r = cuMemAlloc(&config_index, index_bytes);
-  if (r == CUDA_SUCCESS) r = cuMemsetD8(config_index, 0, index_bytes);
+  CUresult r = cuMemAlloc(&config_index, static_cast<size_t>(total) * sizeof(int32_t));
+  for (int32_t k = 0; k < b->part_count() && r == CUDA_SUCCESS; ++k)
+    if (b->part_size(k) > 0)
+      r = cuMemsetD32(config_index + static_cast<size_t>(b->part_first(k)) * sizeof(int32_t), static_cast<unsigned>(k),
+                      static_cast<size_t>(b->part_size(k)));
   if (r != CUDA_SUCCESS) {
     if (config_index) cuMemFree(config_index);
     return fail(error, cu_error_text(r, "cuMemAlloc(config index)")), nullptr;
   }
-  return std::make_unique<GpuEnv>(ctx, std::move(*m), std::move(*b), std::move(pack), l.config.visual.H, l.config.visual.W,
-                                  l.spec_hash, config_index);
+  const VisualParams& vp = parts.front().loaded->config.visual;
+  std::vector<AssetPack> packs;
+  for (GpuEnvPart& p : parts) packs.push_back(std::move(p.pack));
+  return std::make_unique<GpuEnv>(ctx, std::move(modules), std::move(*b), std::move(packs), vp.H, vp.W, hash,
+                                  config_index);
+}
+
+std::unique_ptr<Env> open_gpu(const Loaded& l, const std::string& source, const std::string& fatbin, AssetPack pack,
+                              const Options& o, std::string* error, ErrorKind* kind) {
+  std::vector<GpuEnvPart> parts;
+  parts.push_back(GpuEnvPart{&l, source, fatbin, std::move(pack), o.num_envs});
+  return open_gpu_parts(std::move(parts), l.spec_hash, o, error, kind);
 }
 #endif
 
@@ -459,8 +499,11 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
   if (parts.empty() || total <= 0 || total > INT32_MAX || o.num_threads <= 0)
     return fail(error, "kage::open_mixture: give one or more parts with 1 to 2^31 - 1 environments in all, and a "
                        "positive thread count"), nullptr;
-  if (o.backend != Backend::kCpu)
-    return fail(error, "kage::open_mixture: a mixture runs on the CPU backend for now"), nullptr;
+#if !defined(KAGE_API_HAVE_CUDA)
+  if (o.backend == Backend::kGpu)
+    return *kind = ErrorKind::kDevice,
+           fail(error, "kage::open_mixture: GPU backend not built (no CUDA toolkit at build time)"), nullptr;
+#endif
   std::error_code ec;
   for (const MixturePart& p : parts)
     if (fs::is_directory(p.path, ec))
@@ -491,9 +534,27 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
   }
   *kind = ErrorKind::kUsage;
   for (const LoweredConfig& c : lowered)  // the environments take the same memory in every part but the scratch
-    if (!fits_in_memory(c.latent, c.visual, Options{o.backend, static_cast<int32_t>(total), o.num_threads}, error))
+    if (o.backend == Backend::kCpu &&
+        !fits_in_memory(c.latent, c.visual, Options{o.backend, static_cast<int32_t>(total), o.num_threads}, error))
       return nullptr;
   *kind = ErrorKind::kOther;
+#if defined(KAGE_API_HAVE_CUDA)
+  if (o.backend == Backend::kGpu) {
+    // One module per part (each config's generated source through NVRTC and the kernel cache), one batch.
+    std::vector<Loaded> loaded;
+    for (size_t k = 0; k < parts.size(); ++k) loaded.push_back(Loaded{(*specs)[k].sha256(), std::move(lowered[k])});
+    std::vector<GpuEnvPart> gpu;
+    for (size_t k = 0; k < parts.size(); ++k) {
+      AssetPackResult assets = load_asset_pack(loaded[k].config.assets);
+      if (!assets.ok()) return fail(error, "kage::open_mixture: " + assets.error), nullptr;
+      const GeneratedSource g = generate_source({loaded[k].spec_hash, loaded[k].config.latent, loaded[k].config.visual});
+      gpu.push_back(GpuEnvPart{&loaded[k], g.text, "", std::move(*assets.pack), parts[k].num_envs});
+    }
+    std::unique_ptr<Env> env = open_gpu_parts(std::move(gpu), mixture_sha256(identity), o, error, kind);
+    if (!env && error) *error = "kage::open_mixture: " + *error;
+    return env;
+  }
+#endif
   std::vector<HostEnvPart> host;
   for (size_t k = 0; k < parts.size(); ++k) {
     AssetPackResult assets = load_asset_pack(lowered[k].assets);

@@ -185,8 +185,10 @@ struct MixturePart {
 /// axes: one hidden game (every latent key equal) and one observation shape, which kagec certifies first (its
 /// located diagnostics, kind kConfig, before anything is loaded). Each part runs its own kernels and writes its
 /// rows of the one set of outputs, so environment i equals environment i of its config run alone with the same
-/// seed and actions. options.num_envs is ignored (the batch has the parts' sum); CPU backend only (kUsage on
-/// the GPU). The spec hash is a mixture's (the configs' Spec hashes and counts: kagec diff --mixture).
+/// seed and actions. options.num_envs is ignored (the batch has the parts' sum). Either backend: on the GPU one
+/// device batch whose parts each run their config's own module (config_index() is then a device array), on the
+/// stream options.stream. The spec hash is a mixture's (the configs' Spec hashes and counts: kagec diff
+/// --mixture).
 std::unique_ptr<Env> open_mixture(const std::vector<MixturePart>& parts, const Options& options, std::string* error,
                                   ErrorKind* kind = nullptr);
 

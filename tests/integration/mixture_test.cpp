@@ -105,9 +105,23 @@ TEST_CASE("open_mixture refuses before it loads anything, each refusal of its ki
   CHECK_FALSE(kage::open_mixture({{kNearGoal, 1}, {kRoot + "/configs", 1}}, o, &error, &kind));
   CHECK(kind == kage::ErrorKind::kUsage);
   CHECK(error.find("is a kagec compile directory") != std::string::npos);
+  // On the GPU backend the certificate comes first too, before any device is looked for.
   kage::Options gpu;
   gpu.backend = kage::Backend::kGpu;
-  CHECK_FALSE(kage::open_mixture({{kNearGoal, 1}, {kNearGoalRed, 1}}, gpu, &error, &kind));
-  CHECK(kind == kage::ErrorKind::kUsage);
-  CHECK(error.find("CPU backend") != std::string::npos);
+  CHECK_FALSE(kage::open_mixture({{kNearGoal, 2}, {kRoot + "/tests/python/configs/long_episode.yaml", 2}}, gpu, &error,
+                                 &kind));
+  CHECK(kind == kage::ErrorKind::kConfig);
+  CHECK(error.find("[certify-mixture-latent]") != std::string::npos);
+}
+
+TEST_CASE("open_mixture on the GPU backend refuses with kDevice where there is none", "[integration][api][mixture]") {
+  // These tests link kage_api (no GPU backend): past the certificate, the refusal says so. The GPU mixture
+  // itself is tests/gpu/test_mixture_gpu.py's (run on a GPU machine).
+  kage::Options gpu;
+  gpu.backend = kage::Backend::kGpu;
+  std::string error;
+  kage::ErrorKind kind = kage::ErrorKind::kNone;
+  CHECK_FALSE(kage::open_mixture({{kNearGoal, 3}, {kNearGoalRed, 2}}, gpu, &error, &kind));
+  CHECK(kind == kage::ErrorKind::kDevice);
+  CHECK(error.find("GPU backend not built") != std::string::npos);
 }
