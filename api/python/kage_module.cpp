@@ -499,14 +499,16 @@ PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& dev
   return opened([&](std::string* error, kage::ErrorKind* kind) { return kage::open(path, o, error, kind); });
 }
 
-PyEnv open_mixture(const std::vector<std::string>& paths, const std::vector<int32_t>& counts, int32_t num_threads,
-                   const std::string& asset_root) {
+PyEnv open_mixture(const std::vector<std::string>& paths, const std::vector<int32_t>& counts, const std::string& device,
+                   int32_t num_threads, const std::string& asset_root, uintptr_t stream) {
   if (paths.size() != counts.size()) raise_value_error("open_mixture: one environment count per config");
   std::vector<kage::MixturePart> parts;
   for (size_t k = 0; k < paths.size(); ++k) parts.push_back(kage::MixturePart{paths[k], counts[k]});
   kage::Options o;
+  o.backend = device == "cuda" ? kage::Backend::kGpu : kage::Backend::kCpu;
   o.num_threads = num_threads;
   o.asset_root = asset_root;
+  o.stream = reinterpret_cast<void*>(stream);
   return opened([&](std::string* error, kage::ErrorKind* kind) { return kage::open_mixture(parts, o, error, kind); });
 }
 
@@ -573,8 +575,8 @@ PYBIND11_MODULE(_kage, m) {
   }, "(name, numpy dtype, meaning) of every info field, in order.");
   m.def("open", &open_env, py::arg("path"), py::arg("num_envs"), py::arg("device"), py::arg("num_threads"),
         py::arg("asset_root"), py::arg("stream"));
-  m.def("open_mixture", &open_mixture, py::arg("paths"), py::arg("counts"), py::arg("num_threads"),
-        py::arg("asset_root"));
+  m.def("open_mixture", &open_mixture, py::arg("paths"), py::arg("counts"), py::arg("device"), py::arg("num_threads"),
+        py::arg("asset_root"), py::arg("stream"));
 
   py::class_<DeviceArray>(m, "DeviceArray",
                           "A [N, ...] array in GPU memory, owned by an environment: take it with "

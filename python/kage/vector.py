@@ -337,7 +337,8 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
     which kagec certifies first (a config that differs raises ``kage.ConfigError`` naming the first latent key,
     located, and both files). Environment i gets the seed it would get in a batch of one config
     (``env_seeds(seed, num_envs)[i]``), so each config's slice equals that config run alone with those
-    seeds. A mixture runs on the CPU.
+    seeds. A mixture runs on either device, from YAML configs; on the GPU each config's environments run
+    that config's own kernels on their rows of the one set of device buffers (no copy).
 
     ``seed`` seeds ``reset()`` calls without a seed. ``asset_root`` resolves the config's asset paths
     (default: relative to the file that names them). ``threads``: CPU worker threads (default: one
@@ -363,8 +364,6 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
     if not _is_integer(num_envs) or not 0 < num_envs <= MAX_INT32:
         raise ValueError(f"num_envs={num_envs!r}: a positive integer up to {MAX_INT32}")
     counts = _mixture.split(int(num_envs), _mixture.weights_of(weights, len(configs))) if mixture else None
-    if mixture and device != "cpu":
-        raise ValueError(f"device={device!r}: a mixture runs on the CPU for now (device='cpu')")
     seed = _seed_value(seed)
     if asset_root is not None:
         if not isinstance(asset_root, (str, bytes, os.PathLike)):
@@ -386,7 +385,8 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
     if mixture:
         # kagec's certificate first: a refusal (ConfigError, one located line) before anything is made.
         front_end.certify_mixture(configs, asset_root)
-        handle = native().open_mixture(configs, list(counts), int(threads), asset_root or "")
+        handle = native().open_mixture(configs, list(counts), device, int(threads), asset_root or "",
+                                       int(stream_handle))
     else:
         handle = native().open(configs[0], int(num_envs), device, int(threads), asset_root or "", int(stream_handle))
     return VecEnv(handle, configs if mixture else configs[0], seed, asset_root, counts)

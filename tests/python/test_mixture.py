@@ -199,8 +199,8 @@ def test_other_refusals_are_one_line_each(nothing_opened, tmp_path):
     with pytest.raises(ValueError, match="weights= splits a mixture") as e:
         kage.make_vec(NEAR_GOAL, 2, weights=[1])
     refused(e)
-    with pytest.raises(ValueError, match="a mixture runs on the CPU") as e:
-        kage.make_vec(MIX, 2, device="cuda")
+    with pytest.raises(kage.ConfigError) as e:  # the certificate first on the GPU too, before any device
+        kage.make_vec([SIMPLEST, LONG_EPISODE], 4, device="cuda")
     refused(e)
     with pytest.raises(TypeError, match=r"configs\[1\]") as e:
         kage.make_vec([NEAR_GOAL, 3], 2)
