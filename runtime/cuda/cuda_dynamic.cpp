@@ -75,6 +75,7 @@ KAGE_CU_FORWARD(cuMemcpyHtoD, (CUdeviceptr dst, const void* src, size_t bytes), 
 KAGE_CU_FORWARD(cuMemcpyDtoH, (void* dst, CUdeviceptr src, size_t bytes), (dst, src, bytes))
 KAGE_CU_FORWARD(cuMemcpyDtoD, (CUdeviceptr dst, CUdeviceptr src, size_t bytes), (dst, src, bytes))
 KAGE_CU_FORWARD(cuMemsetD8, (CUdeviceptr p, unsigned char v, size_t n), (p, v, n))
+KAGE_CU_FORWARD(cuMemsetD32, (CUdeviceptr p, unsigned int v, size_t n), (p, v, n))
 KAGE_CU_FORWARD(cuMemsetD8Async, (CUdeviceptr p, unsigned char v, size_t n, CUstream s), (p, v, n, s))
 KAGE_CU_FORWARD(cuMemcpyHtoDAsync, (CUdeviceptr dst, const void* src, size_t bytes, CUstream s), (dst, src, bytes, s))
 KAGE_CU_FORWARD(cuMemcpyDtoHAsync, (void* dst, CUdeviceptr src, size_t bytes, CUstream s), (dst, src, bytes, s))
