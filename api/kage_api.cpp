@@ -499,11 +499,6 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
   if (parts.empty() || total <= 0 || total > INT32_MAX || o.num_threads <= 0)
     return fail(error, "kage::open_mixture: give one or more parts with 1 to 2^31 - 1 environments in all, and a "
                        "positive thread count"), nullptr;
-#if !defined(KAGE_API_HAVE_CUDA)
-  if (o.backend == Backend::kGpu)
-    return *kind = ErrorKind::kDevice,
-           fail(error, "kage::open_mixture: GPU backend not built (no CUDA toolkit at build time)"), nullptr;
-#endif
   std::error_code ec;
   for (const MixturePart& p : parts)
     if (fs::is_directory(p.path, ec))
@@ -524,6 +519,11 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
     print_text(diags, s);
     return fail(error, s.str() + "kage::open_mixture: not a mixture of these configs"), nullptr;
   }
+#if !defined(KAGE_API_HAVE_CUDA)
+  if (o.backend == Backend::kGpu)
+    return *kind = ErrorKind::kDevice,
+           fail(error, "kage::open_mixture: GPU backend not built (no CUDA toolkit at build time)"), nullptr;
+#endif
   std::vector<LoweredConfig> lowered;
   std::vector<std::pair<std::string, int32_t>> identity;
   for (size_t k = 0; k < parts.size(); ++k) {

@@ -108,9 +108,11 @@ TEST_CASE("open_mixture refuses before it loads anything, each refusal of its ki
   // On the GPU backend the certificate comes first too, before any device is looked for.
   kage::Options gpu;
   gpu.backend = kage::Backend::kGpu;
-  CHECK_FALSE(kage::open_mixture({{kNearGoal, 2}, {kRoot + "/tests/python/configs/long_episode.yaml", 2}}, gpu, &error,
-                                 &kind));
+  CHECK_FALSE(kage::open_mixture({{kRoot + "/configs/throughput/simplest.yaml", 2},
+                                  {kRoot + "/tests/python/configs/long_episode.yaml", 2}},
+                                 gpu, &error, &kind));
   CHECK(kind == kage::ErrorKind::kConfig);
+  CHECK(error.find("long_episode.yaml:4:1: error: mixture of") != std::string::npos);
   CHECK(error.find("[certify-mixture-latent]") != std::string::npos);
 }
 
