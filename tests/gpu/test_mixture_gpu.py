@@ -149,6 +149,21 @@ def test_a_mixture_with_npcs_equals_its_configs_alone():
                 e.close()
 
 
+def test_a_part_of_no_environments_and_a_side_stream():
+    """Weights that leave a config without environments (its kernels never launch), on a side stream: the same
+    bytes as the CPU mixture."""
+    n, steps = 9, 60
+    actions = np.random.default_rng(8).integers(0, 8, size=(steps, n), dtype=np.int64)
+    side = torch.cuda.Stream()
+    with kage.make_vec(MIX[:3], n, device="cuda", weights=[2, 0, 1], stream=side) as gpu, \
+            kage.make_vec(MIX[:3], n, device="cpu", weights=[2, 0, 1]) as cpu:
+        assert gpu.counts == cpu.counts == (6, 0, 3) and gpu.stream == side.cuda_stream
+        with torch.cuda.stream(side):
+            check_whole(snapshot(gpu.reset(seed=1)), snapshot(cpu.reset(seed=1)), "reset")
+            for t, a in enumerate(actions):
+                check_whole(snapshot(gpu.step(torch.as_tensor(a, device="cuda"))), snapshot(cpu.step(a)), f"step {t + 1}")
+
+
 def test_a_saved_gpu_mixture_continues_exactly_on_either_device():
     n = 64
     rng = np.random.default_rng(4)
