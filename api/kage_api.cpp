@@ -365,12 +365,11 @@ std::optional<CudaModule> gpu_module(const std::string& spec_hash, const std::st
   return CudaModule::compile(source, "kage_" + spec_hash.substr(0, 16) + ".cu", no, error);
 }
 
-/// One config of a GPU batch: its Spec hash, lowered parameters, module source (or fatbin), assets and
-/// environment count.
+/// One config of a GPU batch: its Spec hash and lowered parameters, its generated source (or fatbin path),
+/// its assets and its environment count.
 struct GpuEnvPart {
   const Loaded* loaded;
-  std::string source;
-  std::string fatbin;
+  std::string source, fatbin;
   AssetPack pack;
   int32_t num_envs;
 };
@@ -389,24 +388,22 @@ std::unique_ptr<Env> open_gpu_parts(std::vector<GpuEnvPart> parts, const std::st
     modules.push_back(std::move(*m));
   }
   std::vector<DevicePartSource> sources;
-  int64_t total = 0;
   for (size_t k = 0; k < parts.size(); ++k) {
     const LoweredConfig& c = parts[k].loaded->config;
     sources.push_back(DevicePartSource{&modules[k], c.latent, c.visual, parts[k].pack.view(), parts[k].num_envs});
-    total += parts[k].num_envs;
   }
   auto b = DeviceBatch::create(sources, error);
   if (!b) return nullptr;
   b->set_stream(static_cast<CUstream>(o.stream));
-  CUdeviceptr config_index = 0;
-  CUresult r = cuMemAlloc(&config_index, static_cast<size_t>(total) * sizeof(int32_t));
+  CUdeviceptr config_index = 0;  // each environment's part
+  CUresult r = cuMemAlloc(&config_index, static_cast<size_t>(b->size()) * sizeof(int32_t));
   for (int32_t k = 0; k < b->part_count() && r == CUDA_SUCCESS; ++k)
     if (b->part_size(k) > 0)
       r = cuMemsetD32(config_index + static_cast<size_t>(b->part_first(k)) * sizeof(int32_t), static_cast<unsigned>(k),
                       static_cast<size_t>(b->part_size(k)));
   if (r != CUDA_SUCCESS) {
     if (config_index) cuMemFree(config_index);
-    return fail(error, cu_error_text(r, "cuMemAlloc(config index)")), nullptr;
+    return fail(error, cu_error_text(r, "config index")), nullptr;
   }
   const VisualParams& vp = parts.front().loaded->config.visual;
   std::vector<AssetPack> packs;
@@ -533,11 +530,17 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
     identity.emplace_back((*specs)[k].sha256(), parts[k].num_envs);
   }
   *kind = ErrorKind::kUsage;
-  for (const LoweredConfig& c : lowered)  // the environments take the same memory in every part but the scratch
-    if (o.backend == Backend::kCpu &&
-        !fits_in_memory(c.latent, c.visual, Options{o.backend, static_cast<int32_t>(total), o.num_threads}, error))
-      return nullptr;
+  Options whole = o;  // the environments take the same memory in every part but the scratch
+  whole.num_envs = static_cast<int32_t>(total);
+  for (const LoweredConfig& c : lowered)
+    if (o.backend == Backend::kCpu && !fits_in_memory(c.latent, c.visual, whole, error)) return nullptr;
   *kind = ErrorKind::kOther;
+  std::vector<AssetPack> packs;
+  for (const LoweredConfig& c : lowered) {
+    AssetPackResult assets = load_asset_pack(c.assets);
+    if (!assets.ok()) return fail(error, "kage::open_mixture: " + assets.error), nullptr;
+    packs.push_back(std::move(*assets.pack));
+  }
 #if defined(KAGE_API_HAVE_CUDA)
   if (o.backend == Backend::kGpu) {
     // One module per part (each config's generated source through NVRTC and the kernel cache), one batch.
@@ -545,10 +548,8 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
     for (size_t k = 0; k < parts.size(); ++k) loaded.push_back(Loaded{(*specs)[k].sha256(), std::move(lowered[k])});
     std::vector<GpuEnvPart> gpu;
     for (size_t k = 0; k < parts.size(); ++k) {
-      AssetPackResult assets = load_asset_pack(loaded[k].config.assets);
-      if (!assets.ok()) return fail(error, "kage::open_mixture: " + assets.error), nullptr;
       const GeneratedSource g = generate_source({loaded[k].spec_hash, loaded[k].config.latent, loaded[k].config.visual});
-      gpu.push_back(GpuEnvPart{&loaded[k], g.text, "", std::move(*assets.pack), parts[k].num_envs});
+      gpu.push_back(GpuEnvPart{&loaded[k], g.text, "", std::move(packs[k]), parts[k].num_envs});
     }
     std::unique_ptr<Env> env = open_gpu_parts(std::move(gpu), mixture_sha256(identity), o, error, kind);
     if (!env && error) *error = "kage::open_mixture: " + *error;
@@ -556,12 +557,9 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
   }
 #endif
   std::vector<HostEnvPart> host;
-  for (size_t k = 0; k < parts.size(); ++k) {
-    AssetPackResult assets = load_asset_pack(lowered[k].assets);
-    if (!assets.ok()) return fail(error, "kage::open_mixture: " + assets.error), nullptr;
-    host.push_back(HostEnvPart{nullptr, generic_host_kernels(lowered[k].latent, lowered[k].visual),
-                               std::move(*assets.pack), parts[k].num_envs});
-  }
+  for (size_t k = 0; k < parts.size(); ++k)
+    host.push_back(HostEnvPart{nullptr, generic_host_kernels(lowered[k].latent, lowered[k].visual), std::move(packs[k]),
+                               parts[k].num_envs});
   std::vector<const HostKernels*> kernels;
   for (const HostEnvPart& h : host) kernels.push_back(h.kernels.get());
   const std::string problem = HostBatch::parts_problem(kernels);
