@@ -335,6 +335,30 @@ TEST_CASE("the original's files, in its layout, lint clean without flags and has
   fs::current_path(home);
 }
 
+TEST_CASE("suites/kage_bench_loo.yaml certifies 18 of 18, each pair training on its axis's other looks", "[suite][mixture]") {
+  fs::current_path(source_dir());
+  SuiteRun r;
+  run_manifest(r, "suites/kage_bench_loo.yaml");
+  REQUIRE(r.report.results.size() == 18);
+  CHECK(r.report.passed() == 18);
+  std::map<Axis, int> per_axis;
+  for (const PairResult& p : r.report.results) {
+    INFO(p.pair->name);
+    CHECK(p.passed());
+    REQUIRE(p.pair->mixture);
+    ++per_axis[p.pair->axis];
+    // The pair's train config of kage_bench.yaml, then the axis's other eval configs on its base.
+    const size_t expected = p.pair->axis == Axis::Filters ? 9 : p.pair->axis == Axis::Effects ? 3
+                            : p.pair->name <= "distractors/4"   ? 4
+                                                                : 2;
+    CHECK(p.members.size() == expected);
+    for (const std::string& c : p.pair->mixture->configs()) CHECK(c != p.pair->eval.path);
+  }
+  CHECK(per_axis[Axis::Filters] == 9);
+  CHECK(per_axis[Axis::Effects] == 3);
+  CHECK(per_axis[Axis::Distractors] == 6);
+}
+
 TEST_CASE("a mixture pair's report names its configs, weights and stages; its train hash is their content",
           "[suite][mixture]") {
   fs::current_path(source_dir());
