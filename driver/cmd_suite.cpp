@@ -5,6 +5,7 @@
 
 #include "compiler/analysis/suite.h"
 #include "compiler/basic/file_out.h"
+#include "compiler/codegen/build.h"
 #include "driver/cli_common.h"
 #include "verify/isolation/isolation.h"
 
@@ -19,7 +20,7 @@ size_t add_isolation_evidence(const SuiteReport& report, Json& json, std::ostrea
   size_t failures = 0;
   for (size_t i = 0; i < report.results.size(); ++i) {
     const PairResult& r = report.results[i];
-    if (!r.train || !r.eval) continue;
+    if (!r.train || !r.eval) continue;  // a mixture pair has no one train Spec: its evidence is its certificate
     IsolationOptions options;
     options.latent_pair = r.pair->axis == Axis::Latent;
     const IsolationEvidence ev = dynamic_isolation(*r.train, *r.eval, config_schema(), options);
@@ -51,7 +52,8 @@ int cmd_suite(const std::vector<std::string>& args, CommandIo& io) {
   DiagEngine diags(sources);
   if (!opts.apply(diags, io)) return kExitUsage;
   DiskFileReader reader;
-  const auto suite = load_suite(manifest, sources, reader, diags);
+  // A schedule may name shipped configs (kage_bench/bases/shape_black), found beside the runtime headers.
+  const auto suite = load_suite(manifest, sources, reader, diags, runtime_include_dir() + "/configs");
   if (!suite || diags.has_errors()) {
     print_text(diags, io.err, io.err_is_terminal);
     return kExitErrors;

@@ -7,6 +7,7 @@
 #include "compiler/analysis/mixture.h"
 #include "compiler/analysis/suite.h"
 #include "compiler/basic/file_out.h"
+#include "compiler/codegen/build.h"
 
 namespace kage::python {
 namespace {
@@ -61,7 +62,7 @@ FrontEndResult suite_report(const std::string& manifest) {
   SourceManager sources;
   DiagEngine diags(sources);
   DiskFileReader reader;
-  const auto suite = load_suite(manifest, sources, reader, diags);
+  const auto suite = load_suite(manifest, sources, reader, diags, runtime_include_dir() + "/configs");
   if (!suite || diags.has_errors()) return {"", diagnostics_text(diags) + "kage: cannot read suite '" + manifest + "'"};
   const SuiteReport report = run_suite(*suite, ResolveOptions{}, sources, reader, diags, nullptr);
   diags.disable_warnings();

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -10,20 +11,36 @@
 #include <set>
 #include <sstream>
 
+#include "compiler/analysis/mixture.h"
 #include "compiler/basic/file_out.h"
 #include "compiler/parse/compose.h"
+#include "fileio/sha256.h"
 
 namespace kage {
 
 std::string ConfigRef::label() const { return inline_doc ? "(inline)" : path; }
 
+std::vector<std::string> TrainMixture::configs() const {
+  std::vector<std::string> out;
+  for (const TrainStage& stage : stages)
+    for (const WeightedConfig& c : stage.configs)
+      if (std::find(out.begin(), out.end(), c.path) == out.end()) out.push_back(c.path);
+  return out;
+}
+
+std::string TrainMixture::label() const {
+  return schedule.empty() ? "mixture of " + std::to_string(configs().size()) : schedule;
+}
+
 namespace {
 
 class SuiteLoader {
  public:
-  SuiteLoader(SourceManager& sources, DiagEngine& diags) : sources_(sources), diags_(diags) {}
+  SuiteLoader(SourceManager& sources, FileReader& reader, DiagEngine& diags, std::string shipped_configs)
+      : sources_(sources), reader_(reader), diags_(diags), shipped_configs_(std::move(shipped_configs)) {}
 
-  std::optional<Suite> load(const std::string& path, FileReader& reader) {
+  std::optional<Suite> load(const std::string& path) {
+    FileReader& reader = reader_;
     std::string err;
     const auto text = reader.read(path, &err);
     if (!text) {
@@ -151,6 +168,218 @@ class SuiteLoader {
     return ref;
   }
 
+  /// `train:` of a pair or sweep: one config (`ref`), or a mixture or schedule (`mixture`). False on errors.
+  bool training_of(const DocNode& map, const Suite& suite, ConfigRef& ref, std::optional<TrainMixture>& mixture) {
+    const DocEntry* e = map.find("train");
+    if (e && e->value.is_seq()) {
+      TrainStage stage;
+      if (!stage_configs(e->value, nullptr, suite.dir, false, stage)) return false;
+      mixture = TrainMixture{{}, {std::move(stage)}};
+      return true;
+    }
+    if (e && e->value.is_map() && e->value.find("schedule")) {
+      for (const DocEntry& k : e->value.entries)
+        if (k.key != "schedule") {
+          diags_.report(Rule::SuiteInvalid, k.key_range,
+                        "unknown key '" + k.key + "' beside 'schedule'; write {schedule: PATH} alone");
+          return false;
+        }
+      const Scalar v = scalar_value(e->value.find("schedule")->value);
+      if (!std::holds_alternative<std::string>(v)) {
+        diags_.report(Rule::SuiteInvalid, e->value.find("schedule")->value.range,
+                      "'schedule' must be the path of a schedule file (a YAML list of stages)");
+        return false;
+      }
+      return load_schedule(join_path(suite.dir, std::get<std::string>(v)), e->value.find("schedule")->value.range,
+                           mixture);
+    }
+    auto one = config_of(map, "train", suite);
+    if (!one) return false;
+    ref = std::move(*one);
+    return true;
+  }
+
+  /// The configs of a mixture (a list of PATH or {config: PATH, weight: W}), or of a schedule's stage (`configs`
+  /// with `weights` beside it, in a schedule file, where names of shipped configs are taken too).
+  bool stage_configs(const DocNode& list, const DocEntry* weights, const std::string& dir, bool in_schedule,
+                     TrainStage& stage) {
+    if (list.items.empty()) {
+      diags_.report(in_schedule ? Rule::SuiteScheduleInvalid : Rule::SuiteInvalid, list.range,
+                    "a mixture needs at least one config");
+      return false;
+    }
+    bool ok = true;
+    for (const DocNode& item : list.items) {
+      WeightedConfig c;
+      c.range = item.range;
+      const DocNode* path = &item;
+      if (item.is_map() && !in_schedule) {
+        for (const DocEntry& k : item.entries)
+          if (k.key != "config" && k.key != "weight") {
+            diags_.report(Rule::SuiteInvalid, k.key_range,
+                          "unknown key '" + k.key + "' in a mixture's config; expected config and weight");
+            ok = false;
+          }
+        const DocEntry* config = item.find("config");
+        if (!config) {
+          diags_.report(Rule::SuiteInvalid, item.range, "a mixture's config needs 'config: PATH'");
+          ok = false;
+          continue;
+        }
+        path = &config->value;
+        if (const DocEntry* w = item.find("weight")) ok = weight_of(w->value, c.weight) && ok;
+      }
+      const Scalar v = scalar_value(*path);
+      if (!std::holds_alternative<std::string>(v)) {
+        diags_.report(in_schedule ? Rule::SuiteScheduleInvalid : Rule::SuiteInvalid, path->range,
+                      in_schedule ? "each config of a stage must be a path or a shipped config's name"
+                                  : "each config of a mixture must be a path or {config: PATH, weight: W}");
+        ok = false;
+        continue;
+      }
+      const std::optional<std::string> found = find_config(std::get<std::string>(v), dir, in_schedule, path->range);
+      if (!found) {
+        ok = false;
+        continue;
+      }
+      c.path = *found;
+      stage.configs.push_back(std::move(c));
+    }
+    if (weights && ok) {
+      if (!weights->value.is_seq() || weights->value.items.size() != stage.configs.size()) {
+        diags_.report(Rule::SuiteScheduleInvalid, weights->value.range,
+                      "'weights' must be a list of " + std::to_string(stage.configs.size()) +
+                          " numbers, one per config of the stage");
+        return false;
+      }
+      for (size_t i = 0; i < stage.configs.size(); ++i)
+        ok = weight_of(weights->value.items[i], stage.configs[i].weight) && ok;
+    }
+    if (ok && std::all_of(stage.configs.begin(), stage.configs.end(),
+                          [](const WeightedConfig& c) { return c.weight == 0; })) {
+      diags_.report(Rule::SuiteMixtureWeight, weights ? weights->value.range : list.range,
+                    "every weight of this mixture is 0, so no environment would run any of its configs; give "
+                    "one config a weight above 0");
+      ok = false;
+    }
+    return ok;
+  }
+
+  bool weight_of(const DocNode& node, double& weight) {
+    const Scalar v = scalar_value(node);
+    double w = std::nan("");
+    if (std::holds_alternative<int64_t>(v)) w = static_cast<double>(std::get<int64_t>(v));
+    if (std::holds_alternative<double>(v)) w = std::get<double>(v);
+    if (!std::isfinite(w) || w < 0) {
+      diags_.report(Rule::SuiteMixtureWeight, node.range,
+                    "weight '" + node.text + "' is not a finite number >= 0; a weight is a config's share of "
+                    "the batch (default 1): write a number such as 1 or 0.5");
+      return false;
+    }
+    weight = w;
+    return true;
+  }
+
+  /// `name` as a file relative to `dir`, else (in a schedule) a shipped config's name; reported where absent.
+  std::optional<std::string> find_config(const std::string& name, const std::string& dir, bool in_schedule,
+                                         Range at) {
+    std::string err;
+    const std::string path = join_path(dir, name);
+    if (reader_.read(path, &err)) return path;
+    if (in_schedule && !shipped_configs_.empty()) {
+      const bool has_ext = name.size() > 5 && name.compare(name.size() - 5, 5, ".yaml") == 0;
+      const std::string shipped = join_path(shipped_configs_, has_ext ? name : name + ".yaml");
+      std::string ignored;
+      if (reader_.read(shipped, &ignored)) return shipped;
+    }
+    diags_.report(Rule::SuiteUnknownConfig, at,
+                  "unknown config '" + name + "': cannot read '" + path + "' (" + err + ")" +
+                      (in_schedule ? ", and it is not a shipped config's name (such as kage_bench/bases/shape_black)"
+                                   : "") +
+                      "; a path is relative to the " + (in_schedule ? "schedule file" : "manifest"));
+    return std::nullopt;
+  }
+
+  /// A schedule file: a list of stages {start, configs, weights?}, the first at 1, each later one after the one before.
+  bool load_schedule(const std::string& path, Range named_at, std::optional<TrainMixture>& mixture) {
+    std::string err;
+    const auto text = reader_.read(path, &err);
+    if (!text) {
+      diags_.report(Rule::SuiteUnknownConfig, named_at,
+                    "cannot read schedule '" + path + "' (" + err + "); the path is relative to the manifest");
+      return false;
+    }
+    const FileId file = sources_.add(path, *text);
+    const auto doc = parse_yaml(sources_, file, diags_);
+    if (!doc) return false;
+    const std::string shape = "; a schedule is a list of stages such as '- {start: 1, configs: [a.yaml, b.yaml], "
+                              "weights: [3, 1]}'";
+    if (!doc->is_seq() || doc->items.empty()) {
+      diags_.report(Rule::SuiteScheduleInvalid, doc->is_null() ? Range{Loc{file, 0}, 0} : doc->range,
+                    std::string("the schedule is a YAML ") + kind_name(*doc) + ", not a list of stages" + shape);
+      return false;
+    }
+    TrainMixture out;
+    out.schedule = path;
+    const std::string dir = parent_dir(path);
+    bool ok = true;
+    const DocNode* previous = nullptr;
+    for (const DocNode& item : doc->items) {
+      if (!item.is_map()) {
+        diags_.report(Rule::SuiteScheduleInvalid, item.range,
+                      std::string("a stage is a mapping, not a ") + kind_name(item) + shape);
+        ok = false;
+        continue;
+      }
+      for (const DocEntry& k : item.entries)
+        if (k.key != "start" && k.key != "configs" && k.key != "weights") {
+          diags_.report(Rule::SuiteScheduleInvalid, k.key_range,
+                        "unknown key '" + k.key + "' in a stage; expected start, configs and weights");
+          ok = false;
+        }
+      const DocEntry* start = item.find("start");
+      const DocEntry* configs = item.find("configs");
+      if (!start || !configs || !configs->value.is_seq()) {
+        diags_.report(Rule::SuiteScheduleInvalid, item.range,
+                      "a stage needs 'start' (its first training iteration) and 'configs' (a list)" + shape);
+        ok = false;
+        continue;
+      }
+      const Scalar s = scalar_value(start->value);
+      if (!std::holds_alternative<int64_t>(s) || std::get<int64_t>(s) < 1) {
+        diags_.report(Rule::SuiteScheduleInvalid, start->value.range,
+                      "'start' must be a training iteration, an integer counted from 1");
+        ok = false;
+        continue;
+      }
+      TrainStage stage;
+      stage.start = std::get<int64_t>(s);
+      const int64_t before = out.stages.empty() ? 0 : out.stages.back().start;
+      if (out.stages.empty() && stage.start != 1) {
+        diags_.report(Rule::SuiteScheduleOrder, start->value.range,
+                      "the first stage starts at iteration " + std::to_string(stage.start) +
+                          "; it must start at 1, so that training has a mixture from its first iteration");
+        ok = false;
+      } else if (!out.stages.empty() && stage.start <= before) {
+        const LineCol at = sources_.line_col(previous->range.begin);
+        diags_.report(Rule::SuiteScheduleOrder, start->value.range,
+                      "this stage starts at iteration " + std::to_string(stage.start) +
+                          ", not after the stage before it (line " + std::to_string(at.line) + ", start " +
+                          std::to_string(before) + "); list stages in the order they start");
+        ok = false;
+      }
+      if (!stage_configs(configs->value, item.find("weights"), dir, true, stage)) {
+        ok = false;
+        continue;
+      }
+      previous = &item;
+      out.stages.push_back(std::move(stage));
+    }
+    if (!ok) return false;
+    mixture = std::move(out);
+    return true;
+  }
+
   std::vector<Allowance> allow_of(const DocNode& map) {
     std::vector<Allowance> out;
     const DocEntry* e = map.find("allow");
@@ -172,12 +401,11 @@ class SuiteLoader {
     p.name = text_of(item, "name", true);
     p.range = item.range;
     const auto axis = axis_of(item);
-    auto train = config_of(item, "train", suite);
+    const bool train = training_of(item, suite, p.train, p.mixture);
     auto eval = config_of(item, "eval", suite);
     p.allow = allow_of(item);
     if (!axis || !train || !eval) return;
     p.axis = *axis;
-    p.train = std::move(*train);
     p.eval = std::move(*eval);
     suite.pairs.push_back(std::move(p));
   }
@@ -185,7 +413,9 @@ class SuiteLoader {
   void add_sweep(Suite& suite, const DocNode& item) {
     const std::string name = text_of(item, "name", true);
     const auto axis = axis_of(item);
-    auto train = config_of(item, "train", suite);
+    ConfigRef train_ref;
+    std::optional<TrainMixture> mixture;
+    const bool train = training_of(item, suite, train_ref, mixture);
     const std::vector<Allowance> allow = allow_of(item);
     const DocEntry* evals = item.find("evals");
     if (!evals) {
@@ -201,7 +431,8 @@ class SuiteLoader {
       auto config = config_of(ev, "config", suite);
       if (!axis || !train || !config) return;
       p.axis = *axis;
-      p.train = *train;
+      p.train = train_ref;
+      p.mixture = mixture;
       p.eval = std::move(*config);
       p.allow = allow;
       for (Allowance& a : allow_of(ev)) p.allow.push_back(a);
@@ -210,7 +441,9 @@ class SuiteLoader {
   }
 
   SourceManager& sources_;
+  FileReader& reader_;
   DiagEngine& diags_;
+  std::string shipped_configs_;
 };
 
 }  // namespace
@@ -224,8 +457,8 @@ std::string certificate_file_name(const std::string& pair_name) {
 }
 
 std::optional<Suite> load_suite(const std::string& path, SourceManager& sources, FileReader& reader,
-                                DiagEngine& diags) {
-  return SuiteLoader(sources, diags).load(path, reader);
+                                DiagEngine& diags, const std::string& shipped_configs) {
+  return SuiteLoader(sources, reader, diags, shipped_configs).load(path);
 }
 
 size_t SuiteReport::passed() const {
@@ -259,6 +492,33 @@ Analysed analyse(const ConfigRef& ref, const Suite& suite, const ResolveOptions&
   return out;
 }
 
+/// A mixture pair's verdict: each training config differs from the eval on the declared axis only (or on
+/// an allowed one, or not at all), and at least one differs on the declared axis.
+Certification certify_members(PairResult& r, const SuitePair& pair) {
+  const std::vector<std::string> names = pair.mixture->configs();
+  Certification c;
+  c.declared = pair.axis;
+  bool declared_changes = false;
+  for (size_t i = 0; i < r.members.size(); ++i) {
+    r.member_diffs.push_back(diff_specs(r.members[i], *r.eval, config_schema()));
+    const SpecDiff& diff = r.member_diffs.back();
+    for (Axis a : diff.axes()) c.measured.insert(a);
+    declared_changes = declared_changes || diff.axes().count(pair.axis);
+    if (diff.changes.empty()) continue;  // a training config equal to the eval changes nothing
+    const Certification one = certify(diff, pair.axis, pair.allow);
+    for (const std::string& problem : one.problems) c.problems.push_back("training config '" + names[i] + "': " + problem);
+    for (const Allowance& a : one.used_allowances)
+      if (std::none_of(c.used_allowances.begin(), c.used_allowances.end(),
+                       [&](const Allowance& u) { return u.axis == a.axis; }))
+        c.used_allowances.push_back(a);
+  }
+  if (!declared_changes)
+    c.problems.push_back(std::string("declared axis '") + axis_name(pair.axis) +
+                         "' does not change: no training config differs from the eval on it");
+  c.certified = c.problems.empty();
+  return c;
+}
+
 }  // namespace
 
 SuiteReport run_suite(const Suite& suite, const ResolveOptions& options, SourceManager& sources, FileReader& reader,
@@ -278,6 +538,25 @@ SuiteReport run_suite(const Suite& suite, const ResolveOptions& options, SourceM
       *progress << "\r\033[K[" << index << "/" << suite.pairs.size() << "] " << pair.name << std::flush;
     PairResult r;
     r.pair = &pair;
+    if (pair.mixture) {  // the training configs as one mixture, then each against the eval
+      const Analysed eval = side(pair.eval);
+      DiagEngine local(sources);
+      auto members = analyze_mixture(pair.mixture->configs(), options, sources, reader, local);
+      for (const Diagnostic& d : local.sorted()) diags.report(d.rule, d.range, d.message, d.path) = d;
+      r.lint_ok = members && !local.has_errors() && eval.ok;
+      r.warnings = local.warning_count() + eval.warnings;
+      r.eval = eval.spec;
+      if (members) r.members = std::move(*members);
+      if (r.lint_ok) {
+        r.cert = certify_members(r, pair);
+      } else {
+        r.cert.declared = pair.axis;
+        r.cert.problems.push_back(
+            "a config of this pair has errors, or its training configs are no mixture (see the diagnostics above)");
+      }
+      report.results.push_back(std::move(r));
+      continue;
+    }
     const Analysed train = side(pair.train);
     const Analysed eval = side(pair.eval);
     r.lint_ok = train.ok && eval.ok;
@@ -318,12 +597,60 @@ void print_suite_table(const Suite& suite, const SuiteReport& report, std::ostre
   out << suite.name << ": " << report.passed() << " of " << report.results.size() << " pairs certified\n";
 }
 
+namespace {
+
+/// A mixture pair's "train": {"name": "mixture of N" or the schedule file, "spec_sha256": the SHA-256 of the
+/// compact JSON {"kage_training": 1, "stages": [{"configs": [{"spec_sha256", "weight"}], "start"}]} (what the
+/// training runs, whatever the files are called; "" while a config has errors), "schedule": the schedule
+/// file or null, "stages": [{"start", "configs": [{"name", "spec_sha256", "weight"}]}]}.
+Json training_json(const PairResult& r) {
+  const TrainMixture& m = *r.pair->mixture;
+  const std::vector<std::string> names = m.configs();
+  auto hash_of = [&](const std::string& path) -> std::string {
+    const size_t i = static_cast<size_t>(std::find(names.begin(), names.end(), path) - names.begin());
+    return i < r.members.size() ? r.members[i].sha256() : "";
+  };
+  Json stages = Json::array(), identity = Json::array();
+  for (const TrainStage& stage : m.stages) {
+    Json configs = Json::array(), hashes = Json::array();
+    for (const WeightedConfig& c : stage.configs) {
+      configs.push_back(Json{{"name", c.path}, {"spec_sha256", hash_of(c.path)}, {"weight", c.weight}});
+      hashes.push_back(Json{{"spec_sha256", hash_of(c.path)}, {"weight", c.weight}});
+    }
+    stages.push_back(Json{{"start", stage.start}, {"configs", configs}});
+    identity.push_back(Json{{"start", stage.start}, {"configs", hashes}});
+  }
+  const bool complete = r.members.size() == names.size();
+  return Json{{"name", m.label()},
+              {"spec_sha256", complete ? sha256_hex(Json{{"kage_training", 1}, {"stages", identity}}.dump()) : ""},
+              {"schedule", m.schedule.empty() ? Json() : Json(m.schedule)},
+              {"stages", stages}};
+}
+
+/// A mixture pair's changes: each training config's against the eval, marked with the config's name.
+Json member_changes(const PairResult& r) {
+  const std::vector<std::string> names = r.pair->mixture->configs();
+  Json changes = Json::array();
+  for (size_t i = 0; i < r.member_diffs.size(); ++i)
+    for (const Change& ch : r.member_diffs[i].changes)
+      changes.push_back(Json{{"config", names[i]}, {"path", ch.path}, {"axis", axis_name(ch.axis)},
+                             {"train", ch.train}, {"eval", ch.eval}});
+  return changes;
+}
+
+}  // namespace
+
 Json suite_report_json(const Suite& suite, const SuiteReport& report) {
   Json pairs = Json::array();
   for (const PairResult& r : report.results) {
-    const PairIdentity train{r.pair->train.label(), r.train ? r.train->sha256() : ""};
+    const PairIdentity train{r.pair->mixture ? r.pair->mixture->label() : r.pair->train.label(),
+                             r.train ? r.train->sha256() : ""};
     const PairIdentity eval{r.pair->eval.label(), r.eval ? r.eval->sha256() : ""};
     Json j = certificate_json(train, eval, r.diff, r.cert);
+    if (r.pair->mixture) {
+      j["train"] = training_json(r);
+      j["changes"] = member_changes(r);
+    }
     j["pair"] = r.pair->name;
     j["sweep"] = r.pair->sweep.empty() ? Json() : Json(r.pair->sweep);
     j["sweep_eval"] = r.pair->sweep.empty() ? Json() : Json(r.pair->sweep_eval);

@@ -1,5 +1,6 @@
 // Suites: manifests of train/eval pairs (and sweeps: one train, several evals),
-// each linted, resolved, diffed and certified against its declared axis.
+// each linted, resolved, diffed and certified against its declared axis. A pair may train on a
+// mixture of configs or on a schedule of mixtures (a curriculum) instead of one config.
 #pragma once
 
 #include <filesystem>
@@ -22,12 +23,37 @@ struct ConfigRef {
   std::string label() const;
 };
 
+/// One config a pair trains on, with its share of the batch.
+struct WeightedConfig {
+  std::string path;   // resolved against the manifest, or against the schedule file that names it
+  double weight = 1;  // finite, >= 0
+  Range range;        // where it is written
+};
+
+/// From training iteration `start` (counted from 1) on, the mixture of `configs`.
+struct TrainStage {
+  int64_t start = 1;
+  std::vector<WeightedConfig> configs;
+};
+
+/// What a pair trains on when it is not one config: a mixture written in the manifest (one stage from
+/// iteration 1), or the stages of a schedule file.
+struct TrainMixture {
+  std::string schedule;  // the schedule file, empty for a mixture written in the manifest
+  std::vector<TrainStage> stages;
+  /// The distinct configs of every stage, in order of first appearance.
+  std::vector<std::string> configs() const;
+  /// "mixture of N" (N distinct configs), or the schedule file.
+  std::string label() const;
+};
+
 struct SuitePair {
   std::string name;
   std::string sweep;       // the sweep this pair belongs to (empty for a plain pair)
   std::string sweep_eval;  // its eval's name within the sweep
   Axis axis = Axis::Background;
   ConfigRef train, eval;
+  std::optional<TrainMixture> mixture;  // set when the pair trains on a mixture or a schedule (`train` is then unset)
   std::vector<Allowance> allow;
   Range range;  // where the pair is written
 };
@@ -44,15 +70,19 @@ struct Suite {
 /// The file name of a pair's certificate under DIR/certificates/ ('/' and spaces become '_').
 std::string certificate_file_name(const std::string& pair_name);
 
-/// Reads a manifest; structural errors go to diags.
+/// Reads a manifest (and the schedule files its pairs name); structural errors go to diags. A schedule's
+/// config that is not a file relative to the schedule is looked up as `shipped_configs`/NAME.yaml (the
+/// shipped configs' folder, where given).
 std::optional<Suite> load_suite(const std::string& path, SourceManager& sources, FileReader& reader,
-                                DiagEngine& diags);
+                                DiagEngine& diags, const std::string& shipped_configs = {});
 
 struct PairResult {
   const SuitePair* pair = nullptr;
   bool lint_ok = false;        // both sides resolved without errors
   size_t warnings = 0;
-  std::optional<Spec> train, eval;
+  std::optional<Spec> train, eval;  // train: unset for a mixture pair
+  std::vector<Spec> members;         // a mixture pair's training configs (TrainMixture::configs() order)
+  std::vector<SpecDiff> member_diffs;  // each member against the eval (a mixture pair's; `diff` stays empty)
   SpecDiff diff;
   Certification cert;
   bool passed() const { return lint_ok && cert.certified; }

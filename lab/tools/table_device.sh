@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# One device-machine call of the whole KAGE-Bench table (issue 27). The runner, `kage.bench run kage_bench
-# --seeds 1-10 --share-training --pack PACK` with the trainer flags FLAGS, trains in DIR on the machine's disk:
+# One device-machine call of the whole KAGE-Bench table (issue 27), or of another suite's (SUITE, SEEDS, PAIRS). The
+# runner, `kage.bench run SUITE --seeds SEEDS [--pairs PAIRS] --share-training --pack PACK` with the trainer flags
+# FLAGS (defaults: kage_bench, 1-10, every pair), trains in DIR on the machine's disk:
 # - GPUS=all (a machine of several GPUs): every task, one worker per GPU (`--gpus all`);
 # - TASK=I: task I alone, on one GPU.
 # The runner runs in a process session of its own (setsid), which the device machine leaves running when a
@@ -8,7 +9,8 @@
 # It runs from a copy of the tree made by the lease's first call (ROOT), since every call copies the working
 # tree afresh over the repository root, which must not change under a running process: a lease runs the code
 # of its first call. That call builds (lab/tools/device_build.sh) and starts DIR from the tasks already
-# published (results/kage-bench-table/packs, unpacked with their checksums), so that only the rest is trained.
+# published (PUBLISHED, default results/kage-bench-table/packs, unpacked with their checksums), so that only the
+# rest is trained.
 # Every call then waits until LIMIT seconds of the call have passed or the runner has ended, packing each task
 # as soon as all its runs have finished: its run data without checkpoints, in $OUT/task_I.tar.gz and
 # $OUT/task_I.sha256 (lab/tools/pack_task.py), so a call brings home what finished since the last; copy them
@@ -38,18 +40,23 @@ DIR=${DIR:-/tmp/kage-table}
 LIMIT=${LIMIT:-585}
 MAX_FILES=${MAX_FILES:-8}
 FLAGS=${FLAGS:---bf16 --fused-input --cuda-graph --triton-conv}
-PUBLISHED=results/kage-bench-table/packs
+PUBLISHED=${PUBLISHED:-results/kage-bench-table/packs}
+SUITE=${SUITE:-kage_bench}
+SEEDS=${SEEDS:-1-10}
 export TRITON_CACHE_DIR=${TRITON_CACHE_DIR:-/tmp/kage-triton-cache}  # compiled kernels kept for the lease
 if [ ! -e "$DIR/tasks.json" ] && compgen -G "$PUBLISHED/task_*.tar.gz" >/dev/null; then
   python3 lab/tools/table_unpack.py "$PUBLISHED" "$DIR" | tail -1 >>"$OUT/call.log" || exit 1
   mkdir -p "$DIR/packed"
   for archive in "$PUBLISHED"/task_*.tar.gz; do name=${archive##*/}; touch "$DIR/packed/${name%.tar.gz}"; done
 fi
-run=(python3 -m kage.bench run kage_bench --seeds 1-10 --share-training --pack "$PACK" "${scope[@]}" --out "$DIR")
+# shellcheck disable=SC2206
+run=(python3 -m kage.bench run "$SUITE" --seeds "$SEEDS" ${PAIRS:+--pairs $PAIRS} --share-training --pack "$PACK"
+     "${scope[@]}" --out "$DIR")
 devices=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | sort | uniq -c |
   sed -E 's/^ *([0-9]+) (.*), ([^,]*)$/\1 x \2 (driver \3)/' | paste -sd ';' -)  # 2 x NVIDIA H200 (driver 580.159.04)
 # The exact call, its settings included: the one that started the runner is the command of what it trains.
-call="COMMIT=$COMMIT ${GPUS:+GPUS=$GPUS }${TASK:+TASK=$TASK }PACK=$PACK LIMIT=$LIMIT bash lab/tools/table_device.sh"
+call="COMMIT=$COMMIT ${GPUS:+GPUS=$GPUS }${TASK:+TASK=$TASK }SUITE=$SUITE SEEDS=$SEEDS ${PAIRS:+PAIRS='$PAIRS' }PACK=$PACK"
+call+=" LIMIT=$LIMIT DIR=$DIR PUBLISHED=$PUBLISHED FLAGS='$FLAGS' bash lab/tools/table_device.sh"
 pack_new() { python3 lab/tools/pack_task.py "$DIR" new "$OUT" "$MAX_FILES" >>"$OUT/call.log"; }
 runner_alive() { [ -s "$DIR/runner.pid" ] && kill -0 "$(cat "$DIR/runner.pid")" 2>/dev/null; }
 mkdir -p "$DIR"

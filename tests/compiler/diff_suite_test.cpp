@@ -335,4 +335,107 @@ TEST_CASE("the original's files, in its layout, lint clean without flags and has
   fs::current_path(home);
 }
 
+TEST_CASE("suites/kage_bench_loo.yaml certifies 18 of 18, each pair training on its axis's other looks", "[suite][mixture]") {
+  fs::current_path(source_dir());
+  SuiteRun r;
+  run_manifest(r, "suites/kage_bench_loo.yaml");
+  REQUIRE(r.report.results.size() == 18);
+  CHECK(r.report.passed() == 18);
+  std::map<Axis, int> per_axis;
+  for (const PairResult& p : r.report.results) {
+    INFO(p.pair->name);
+    CHECK(p.passed());
+    REQUIRE(p.pair->mixture);
+    ++per_axis[p.pair->axis];
+    // The pair's train config of kage_bench.yaml, then the axis's other eval configs on its base.
+    const size_t expected = p.pair->axis == Axis::Filters ? 9 : p.pair->axis == Axis::Effects ? 3
+                            : p.pair->name <= "distractors/4"   ? 4
+                                                                : 2;
+    CHECK(p.members.size() == expected);
+    for (const std::string& c : p.pair->mixture->configs()) CHECK(c != p.pair->eval.path);
+  }
+  CHECK(per_axis[Axis::Filters] == 9);
+  CHECK(per_axis[Axis::Effects] == 3);
+  CHECK(per_axis[Axis::Distractors] == 6);
+}
+
+TEST_CASE("a mixture pair's report names its configs, weights and stages; its train hash is their content",
+          "[suite][mixture]") {
+  fs::current_path(source_dir());
+  const std::string abs = (source_dir() / "configs").string() + "/kage_bench/";
+  TempDir tmp("suite_mixture");
+  write_text(tmp.path() / "schedule.yaml", "- start: 1\n  configs: [" + abs + "bases/image_skeleton.yaml]\n"
+             "- start: 50\n  configs: [kage_bench/filters/2-eval, " + abs + "filters/3-eval.yaml]\n  weights: [3, 1]\n");
+  write_text(tmp.path() / "suite.yaml",
+             "suite: s\npairs:\n"
+             "  - {name: m, axis: filters, eval: " + abs + "filters/1-eval.yaml, train: [" + abs +
+                 "bases/image_skeleton.yaml, {config: " + abs + "filters/2-eval.yaml, weight: 2}]}\n"
+             "  - {name: same, axis: filters, eval: " + abs + "filters/4-eval.yaml, train: [" + abs +
+                 "bases/image_skeleton.yaml, {config: " + abs + "filters/2-eval.yaml, weight: 2}]}\n"
+             "  - {name: s, axis: filters, eval: " + abs + "filters/1-eval.yaml, train: {schedule: schedule.yaml}}\n"
+             "  - {name: plain, axis: filters, eval: " + abs + "filters/1-eval.yaml, train: " + abs +
+                 "bases/image_skeleton.yaml}\n");
+  SourceManager sources;
+  DiagEngine diags(sources);
+  DiskFileReader reader;
+  const auto suite = load_suite((tmp.path() / "suite.yaml").string(), sources, reader, diags,
+                                (source_dir() / "configs").string());
+  REQUIRE(suite);
+  REQUIRE_FALSE(diags.has_errors());
+  const SuiteReport report = run_suite(*suite, {}, sources, reader, diags, nullptr);
+  CHECK(report.passed() == 4);
+  const Json j = suite_report_json(*suite, report);
+  const Json& m = j.at("pairs")[0].at("train");
+  CHECK(m.at("name") == "mixture of 2");
+  CHECK(m.at("schedule").is_null());
+  REQUIRE(m.at("stages").size() == 1);
+  CHECK(m.at("stages")[0].at("start") == 1);
+  REQUIRE(m.at("stages")[0].at("configs").size() == 2);
+  CHECK(m.at("stages")[0].at("configs")[0].at("weight") == 1.0);
+  CHECK(m.at("stages")[0].at("configs")[1].at("weight") == 2.0);
+  CHECK(m.at("stages")[0].at("configs")[1].at("name") == abs + "filters/2-eval.yaml");
+  CHECK(m.at("spec_sha256").get<std::string>().size() == 64);
+  // The same training under another pair hashes alike; a plain pair keeps its config's name and Spec hash.
+  CHECK(j.at("pairs")[1].at("train").at("spec_sha256") == m.at("spec_sha256"));
+  const Json& plain = j.at("pairs")[3].at("train");
+  CHECK(plain == Json{{"name", abs + "bases/image_skeleton.yaml"},
+                      {"spec_sha256", m.at("stages")[0].at("configs")[0].at("spec_sha256")}});
+  // Every change is marked with the training config it belongs to: the base gains brightness, filters/2 too.
+  for (const Json& ch : j.at("pairs")[0].at("changes")) CHECK(ch.at("config").is_string());
+  const Json& s = j.at("pairs")[2].at("train");
+  CHECK(s.at("name") == (tmp.path() / "schedule.yaml").string());
+  CHECK(s.at("schedule") == (tmp.path() / "schedule.yaml").string());
+  REQUIRE(s.at("stages").size() == 2);
+  CHECK(s.at("stages")[1].at("start") == 50);
+  CHECK(s.at("stages")[1].at("configs")[0].at("name") == abs + "filters/2-eval.yaml");
+  CHECK(s.at("stages")[1].at("configs")[0].at("weight") == 3.0);
+}
+
+TEST_CASE("a mixture pair fails where a training config changes another axis or the hidden game",
+          "[suite][mixture]") {
+  fs::current_path(source_dir());
+  const std::string abs = (source_dir() / "configs").string() + "/kage_bench/";
+  TempDir tmp("suite_mixture_bad");
+  write_text(tmp.path() / "latent.yaml", "extends: " + abs + "filters/2-eval.yaml\nphysics: {gravity: 0.9}\n");
+  write_text(tmp.path() / "suite.yaml",
+             "suite: s\npairs:\n"
+             "  - {name: other-axis, axis: filters, eval: " + abs + "filters/1-eval.yaml, train: [" + abs +
+                 "bases/image_skeleton.yaml, " + abs + "background/9-eval.yaml]}\n"
+             "  - {name: latent, axis: filters, eval: " + abs + "filters/1-eval.yaml, train: [" + abs +
+                 "bases/image_skeleton.yaml, latent.yaml]}\n");
+  SuiteRun r;
+  run_manifest(r, (tmp.path() / "suite.yaml").string());
+  CHECK(r.report.passed() == 0);
+  const PairResult& other = result(r, "other-axis");
+  CHECK(other.lint_ok);
+  CHECK(has_problem(other.cert, "background/9-eval.yaml': axis 'background' also changes and is not allowed"));
+  const PairResult& latent = result(r, "latent");
+  CHECK_FALSE(latent.lint_ok);
+  bool located = false;
+  for (const Diagnostic& d : r.diags.sorted())
+    located = located || (d.rule == Rule::CertifyMixtureLatent && r.sources.name(d.range.begin.file).find("latent.yaml") !=
+                                                                       std::string::npos);
+  CHECK(located);
+}
+
 }  // namespace kage::test

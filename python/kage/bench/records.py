@@ -89,6 +89,29 @@ def bench_problem(bench, keys: Sequence[str] = tuple(BENCH_KEYS)) -> Optional[st
 def _side_problem(side) -> Optional[str]:
     if not (isinstance(side, dict) and isinstance(side.get("spec_sha256"), str) and isinstance(side.get("name"), str)):
         return "without its name and spec_sha256"
+    if "stages" in side:
+        return _stages_problem(side)
+    return None
+
+
+def _stages_problem(side: dict) -> Optional[str]:
+    """A mixture's or schedule's "stages" ([{"start", "configs": [{"name", "spec_sha256", "weight"}]}]) and
+    "schedule" (a path or null), as kagec suite writes them."""
+    stages, schedule = side["stages"], side.get("schedule")
+    if schedule is not None and not isinstance(schedule, str):
+        return "a mixture whose 'schedule' is neither a path nor null"
+    if not isinstance(stages, list) or not stages:
+        return "a mixture without a list of stages"
+    for stage in stages:
+        configs = stage.get("configs") if isinstance(stage, dict) else None
+        start = stage.get("start") if isinstance(stage, dict) else None
+        if not isinstance(start, int) or isinstance(start, bool) or not isinstance(configs, list) or not configs:
+            return "a mixture with a stage that lacks its start or configs"
+        for c in configs:
+            weight = c.get("weight") if isinstance(c, dict) else None
+            if not (isinstance(c, dict) and isinstance(c.get("name"), str) and isinstance(c.get("spec_sha256"), str)
+                    and isinstance(weight, (int, float)) and not isinstance(weight, bool)):
+                return "a mixture with a config that lacks its name, spec_sha256 or weight"
     return None
 
 

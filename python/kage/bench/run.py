@@ -42,7 +42,7 @@ from kage import front_end, resources
 from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
 from kage.bench.records import MAX_SEED, bench_problem, suite_problem, unit_name_problem
-from kage.bench.units import Unit, select, units_of
+from kage.bench.units import Unit, select, train_stem, training_configs, units_of
 from kage.errors import ConfigError
 from kage.util.files import (LOG_LIMIT, atomic_write, open_regular, os_error_text, read_json_record, read_regular,
                              remove_strays, write_json)
@@ -73,14 +73,15 @@ def parse_seeds(text: str) -> List[int]:
 
 
 # The trainer flags kage.bench sets for each run (the trainer's parser takes no abbreviations of them).
-PER_RUN_FLAGS = ("--train-config-path", "--eval-config-path", "--eval-config-paths", "--eval-config-labels",
+PER_RUN_FLAGS = ("--train-config-path", "--train-config-paths", "--train-weights", "--train-schedule",
+                 "--eval-config-path", "--eval-config-paths", "--eval-config-labels",
                  "--seed", "--out", "--exp-name")
 
 
 def units_to_train(report: dict, wanted: Optional[List[str]]) -> List[Unit]:
     """The suite's pairs and sweeps, in manifest order, or the `wanted` ones; refuses configs written inline."""
     for p in report["pairs"]:
-        if p["train"]["name"] == "(inline)" or p["eval"]["name"] == "(inline)":
+        if "(inline)" in training_configs(p["train"]) or p["eval"]["name"] == "(inline)":
             raise SystemExit(f"kage.bench: pair {p['pair']} writes a config inline in the manifest; "
                              "kage.bench trains only configs in files: move it to a file")
     return select(units_of(report), wanted, "kage.bench")
@@ -99,10 +100,11 @@ MAX_EVALS = 10  # eval configs per run (kage.ppo.train's limit, §3.5)
 
 
 def share_training(units: List[Unit], report: dict) -> List[Unit]:
-    """--share-training: plain pairs whose train configs have one Spec train once per seed, in one run that
-    evaluates all their eval configs (at most MAX_EVALS a run), each under its pair's name as label. A run
-    depends only on its train config, seed and flags, so these pairs' separate runs would train the same
-    agent; the suite's 34 pairs have 7 train configs. Sweeps and pairs with a train config of their own stay."""
+    """--share-training: plain pairs whose training is one (train configs of one Spec, or mixtures or schedules
+    of the same Specs, weights and stages: suite.json's train "spec_sha256") train once per seed, in one run
+    that evaluates all their eval configs (at most MAX_EVALS a run), each under its pair's name as label. A run
+    depends only on its training, seed and flags, so these pairs' separate runs would train the same agent;
+    the suite's 34 pairs have 7 train configs. Sweeps and pairs with a training of their own stay."""
     train_hash = {p["pair"]: p["train"]["spec_sha256"] for p in report["pairs"] if p["sweep"] is None}
     groups: Dict[str, List[Unit]] = {}
     for unit in units:
@@ -112,7 +114,7 @@ def share_training(units: List[Unit], report: dict) -> List[Unit]:
     for spec_hash, members in groups.items():
         if len(members) < 2:
             continue
-        stem = os.path.splitext(os.path.basename(members[0].train))[0]
+        stem = train_stem(members[0].training)
         chunks = [members[i:i + MAX_EVALS] for i in range(0, len(members), MAX_EVALS)]
         for number, chunk in enumerate(chunks, 1):
             part = f"-part{number}" if len(chunks) > 1 else ""
@@ -146,7 +148,8 @@ def check_suite_unchanged(out: str, report: dict) -> None:
         for side in ("train", "eval"):
             if old[side]["spec_sha256"] != p[side]["spec_sha256"]:
                 raise SystemExit(
-                    f"kage.bench: config '{p[side]['name']}' ({p['pair']}, {side}) changed since {out} was "
+                    f"kage.bench: {'training' if 'stages' in p[side] else 'config'} '{p[side]['name']}' "
+                    f"({p['pair']}, {side}) changed since {out} was "
                     f"started (spec {old[side]['spec_sha256'][:12]} then, {p[side]['spec_sha256'][:12]} now): "
                     "restore it, or run into another --out")
 
@@ -174,9 +177,34 @@ def record_bench(out: str, manifest: str, seeds: List[int], units: List[Unit], t
                       "share_training": share, "shared": shared})
 
 
+def training_fields(unit: Unit) -> Dict[str, object]:
+    """What a unit's runs train on, as kage.ppo.train's Args fields: train_config_path for one config;
+    train_config_paths and train_weights for a mixture (its configs as the suite resolved them); train_schedule
+    for a schedule file (whose paths kage.ppo.train resolves against the file, as kagec suite does)."""
+    train = unit.training
+    if "stages" not in train:
+        return {"train_config_path": train["name"]}
+    if train.get("schedule") is not None:
+        return {"train_config_path": "", "train_schedule": train["schedule"]}
+    configs = train["stages"][0]["configs"]
+    return {"train_config_path": "", "train_config_paths": [c["name"] for c in configs],
+            "train_weights": [float(c["weight"]) for c in configs]}
+
+
+def training_flags(unit: Unit) -> List[str]:
+    """training_fields as kage.ppo.train flags."""
+    fields = training_fields(unit)
+    if "train_schedule" in fields:
+        return ["--train-schedule", fields["train_schedule"]]
+    if "train_config_paths" in fields:
+        return ["--train-config-paths", *fields["train_config_paths"],
+                "--train-weights", *(repr(w) for w in fields["train_weights"])]
+    return ["--train-config-path", fields["train_config_path"]]
+
+
 def train_flags(unit: Unit, seed: int, run_dir: str, trainer_args: List[str]) -> List[str]:
     evals = ["--eval-config-path", unit.evals[0]] if len(unit.evals) == 1 else ["--eval-config-paths", *unit.evals]
-    return ["--train-config-path", unit.train, *evals, "--eval-config-labels", *unit.eval_labels, "--seed", str(seed),
+    return [*training_flags(unit), *evals, "--eval-config-labels", *unit.eval_labels, "--seed", str(seed),
             "--out", run_dir, "--exp-name", unit.name.replace("/", "_"), *trainer_args]
 
 
@@ -189,19 +217,37 @@ def checkpoint_iteration(run_dir: str) -> int:
     return iteration if isinstance(iteration, int) and not isinstance(iteration, bool) else 0
 
 
+def training_shape(unit: Unit) -> tuple:
+    """What packed runs must share of their training besides the configs themselves: one config, or a mixture
+    of as many configs, or a schedule (whose stages change the batch at their own iterations)."""
+    train = unit.training
+    if "stages" not in train:
+        return ("config",)
+    if train.get("schedule") is not None:
+        return ("schedule", train["schedule"])
+    return ("mixture", len(train["stages"][0]["configs"]))
+
+
 def packs_of(jobs: List[tuple], size: int) -> List[List[tuple]]:
     """Jobs (unit, seed, run_dir) in packs of at most `size`: a pack's runs evaluate the same number of
-    configs and resume from the same iteration (they step in lockstep)."""
+    configs, train on the same kind of thing (training_shape) and resume from the same iteration (they step
+    in lockstep)."""
     groups: Dict[tuple, List[tuple]] = {}
     for job in jobs:
-        groups.setdefault((len(job[0].evals), checkpoint_iteration(job[2])), []).append(job)
+        groups.setdefault((len(job[0].evals), training_shape(job[0]), checkpoint_iteration(job[2])), []).append(job)
     return [group[i:i + size] for group in groups.values() for i in range(0, len(group), size)]
 
 
 def write_pack_file(path: str, pack: List[tuple], trainer_args: List[str]) -> str:
-    """The pack's runs as kage.ppo.train arguments (python3 -m kage.ppo.train --pack)."""
+    """The pack's runs as kage.ppo.train arguments (python3 -m kage.ppo.train --pack): each run's Args, its
+    training fields (training_fields) set over those of its flags with a single train config."""
     from kage.ppo import train
-    runs = [dataclasses.asdict(train.parse_args(train_flags(u, s, d, trainer_args))) for u, s, d in pack]
+    runs = []
+    for u, s, d in pack:
+        flags = train_flags(u, s, d, trainer_args)
+        cut = len(training_flags(u))
+        args = dataclasses.asdict(train.parse_args(["--train-config-path", u.train_configs[0], *flags[cut:]]))
+        runs.append({**args, **training_fields(u)})
     os.makedirs(os.path.dirname(path), exist_ok=True)
     atomic_write(path, json.dumps({"runs": runs}, indent=1).encode())  # infinities as Infinity: read by Python
     return path

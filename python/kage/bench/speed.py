@@ -120,7 +120,7 @@ def main(argv: List[str]) -> int:
     parser.add_argument("--iterations", type=int, default=3, help="timed iterations per K")
     parser.add_argument("--json", help="also append one JSON line per K to this file")
     args, trainer_args = parser.parse_known_args(argv)
-    if "--train-config-path" not in trainer_args:
+    if not {"--train-config-path", "--train-config-paths", "--train-schedule"} & set(trainer_args):
         trainer_args = ["--train-config-path", "configs/kage_bench/bases/shape_black.yaml",
                         "--eval-config-path", "configs/kage_bench/background/1-eval.yaml", *trainer_args]
     base = train.parse_args(trainer_args)

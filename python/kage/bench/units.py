@@ -1,9 +1,15 @@
 """A suite's units: what one training run per seed covers. A plain pair is a unit; a sweep (one train
 config, several evals) is one unit; under --share-training, the plain pairs of one train config share a
 unit. kage.bench run trains units, kage.bench report reads them back, and kage.bench score evaluates a
-checkpoint on them: all three take them from here."""
+checkpoint on them: all three take them from here.
+
+A pair trains on one config, or on a mixture or a schedule of mixtures: its suite.json "train" then holds
+"stages" ([{"start", "configs": [{"name", "spec_sha256", "weight"}]}]) and "schedule" (the schedule file, or
+null for a mixture written in the manifest), and its "name" says what it is ("mixture of 9", or the schedule
+file)."""
 import dataclasses
 import difflib
+import os
 from typing import Dict, List, Optional
 
 PLAIN_LABEL = "eval"  # the eval label of a plain pair's runs
@@ -26,7 +32,19 @@ class Unit:
 
     @property
     def train(self) -> str:
+        """What the unit trains on, by name: its config, "mixture of N", or its schedule file."""
         return self.pairs[0]["train"]["name"]
+
+    @property
+    def training(self) -> dict:
+        """The suite.json "train" entry of the unit's pairs (one config, a mixture or a schedule)."""
+        return self.pairs[0]["train"]
+
+    @property
+    def train_configs(self) -> List[str]:
+        """The configs the unit trains on, distinct, in order of first appearance: the first is the one its
+        runs' "train" evaluation runs (kage.ppo.train)."""
+        return training_configs(self.training)
 
     @property
     def evals(self) -> List[str]:
@@ -35,6 +53,23 @@ class Unit:
     @property
     def eval_labels(self) -> List[str]:
         return [self.label(p) for p in self.pairs]
+
+
+def training_configs(train: dict) -> List[str]:
+    """The distinct configs of a suite.json "train" entry, in order of first appearance."""
+    if "stages" not in train:
+        return [train["name"]]
+    out: List[str] = []
+    for stage in train["stages"]:
+        out.extend(c["name"] for c in stage["configs"] if c["name"] not in out)
+    return out
+
+
+def train_stem(train: dict) -> str:
+    """A file-name stem for a unit's training: the config's or schedule's file stem, or "mixture-of-N"."""
+    if "stages" in train and train.get("schedule") is None:
+        return f"mixture-of-{len(training_configs(train))}"
+    return os.path.splitext(os.path.basename(train.get("schedule") or train["name"]))[0]
 
 
 def label_of(pair: dict) -> str:

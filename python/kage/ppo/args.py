@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import List, Optional, Tuple
 
 from kage import resources
-from kage.ppo import plugins
+from kage.ppo import plugins, schedule
 
 DESCRIPTION = ("PPO-CNN baseline of KAGE-Bench: train on one config, evaluate on it and on one or more others "
                "(kage-ppo-baseline.md)")
@@ -20,6 +20,14 @@ DESCRIPTION = ("PPO-CNN baseline of KAGE-Bench: train on one config, evaluate on
 @dataclass
 class Args:
     train_config_path: str = field(default="", metadata={"help": "the config to train on (YAML or kagec compile dir)"})
+    train_config_paths: List[str] = field(default_factory=list, metadata={
+        "help": "several YAML configs to train on at once, instead of --train-config-path: one batch split across "
+                "them by --train-weights (a mixture; they must differ only on visual axes)"})
+    train_weights: List[float] = field(default_factory=list, metadata={
+        "help": "one non-negative weight per --train-config-paths config (default: equal)"})
+    train_schedule: Optional[str] = field(default=None, metadata={
+        "help": "a YAML list of stages (start iteration, configs, weights) whose mixture changes at each stage's "
+                "start, instead of --train-config-path (a curriculum; kage.ppo.schedule)"})
     eval_config_path: Optional[str] = field(default=None, metadata={"help": "the config to evaluate on (ppo_jax.py)"})
     eval_config_paths: List[str] = field(default_factory=list, metadata={
         "help": "several configs to evaluate on (ppo_jax_multi_conf.py, spec 3.5)"})
@@ -102,7 +110,7 @@ class Args:
 
 
 # The arguments that differ between the runs of a pack; the others are the pack's, shared.
-PER_RUN = ("train_config_path", "eval_config_path", "eval_config_paths", "eval_config_labels", "seed", "out",
+PER_RUN = ("train_config_path", "train_config_paths", "train_weights", "train_schedule", "eval_config_path", "eval_config_paths", "eval_config_labels", "seed", "out",
            "exp_name")
 
 
@@ -115,8 +123,9 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
         default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default
         if f.type is bool:
             parser.add_argument(flag, action=argparse.BooleanOptionalAction, default=default, help=f.metadata["help"])
-        elif f.type == List[str]:
-            parser.add_argument(flag, nargs="+", default=default, help=f.metadata["help"])
+        elif f.type in (List[str], List[float]):
+            parser.add_argument(flag, nargs="+", type=str if f.type == List[str] else float, default=default,
+                                help=f.metadata["help"])
         else:
             kind = next(t for t in (int, float, str) if f.type in (t, Optional[t]))
             parser.add_argument(flag, type=kind, default=default, help=f.metadata["help"],
@@ -165,6 +174,8 @@ def of_kind(value, kind) -> bool:
         return True
     if kind == List[str]:
         return isinstance(value, list) and all(isinstance(v, str) for v in value)
+    if kind == List[float]:
+        return isinstance(value, list) and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
     if kind is bool:
         return isinstance(value, bool)
     if isinstance(value, bool):
@@ -177,7 +188,7 @@ def of_kind(value, kind) -> bool:
 def kind_name(kind) -> str:
     return {bool: "a boolean", int: "an integer", float: "a number", str: "a string", List[str]: "a list of strings",
             Optional[int]: "an integer or null", Optional[float]: "a number or null",
-            Optional[str]: "a string or null"}.get(kind, str(kind))
+            Optional[str]: "a string or null", List[float]: "a list of numbers"}.get(kind, str(kind))
 
 
 MAX_INT32 = 2**31 - 1  # the environment API's counts are int32
@@ -222,8 +233,15 @@ def range_problems(args: Args) -> List[str]:
 def validate(args: Args) -> List[str]:
     """What is wrong with a combination of flags, each with its fix."""
     problems = range_problems(args)
-    if not args.train_config_path:
-        problems.append("--train-config-path is required")
+    given = [flag for flag, value in (("--train-config-path", args.train_config_path),
+                                      ("--train-config-paths", args.train_config_paths),
+                                      ("--train-schedule", args.train_schedule)) if value]
+    if not given:
+        problems.append("--train-config-path is required (or --train-config-paths or --train-schedule)")
+    elif len(given) > 1:
+        problems.append(f"give one of {' and '.join(given)}: each says what the run trains on")
+    if args.train_weights and not args.train_config_paths:
+        problems.append("--train-weights splits --train-config-paths: give those too, or drop --train-weights")
     if args.eval_config_path and args.eval_config_paths:
         problems.append("give --eval-config-path or --eval-config-paths, not both")
     if args.out and os.path.exists(args.out) and not os.path.isdir(args.out):
@@ -271,14 +289,38 @@ def eval_paths(args: Args) -> List[str]:
 
 
 def configs_of(args: Args) -> List[Tuple[str, str]]:
-    """(label, path) of the configs a run evaluates on: "train" first, then the eval configs."""
-    return [("train", args.train_config_path)] + list(zip(eval_labels(args), eval_paths(args)))
+    """(label, path) of every config of a run: those it trains on ("train", then "train.1", "train.2", ... for the
+    other configs of a mixture or schedule, in order of first appearance), then the eval configs."""
+    return [(training_label(i), path) for i, path in enumerate(schedule.distinct_configs(stages_of(args)))] + \
+        list(zip(eval_labels(args), eval_paths(args)))
+
+
+def stages_of(args: Args) -> List[schedule.Stage]:
+    """What the run trains on, as stages (kage.ppo.schedule); a schedule or weights that cannot train end the
+    trainer with their located line."""
+    try:
+        return schedule.stages_of(args)
+    except schedule.ScheduleError as e:
+        raise SystemExit(f"kage.ppo.train: {e}") from None
+
+
+def training_label(index: int) -> str:
+    """The label of a run's index-th distinct training config: "train" for the first (the evaluation's "train"
+    target, the config eval configs are certified against), "train.<index>" for the others."""
+    return "train" if index == 0 else f"train.{index}"
+
+
+def first_train_config(args: Args) -> str:
+    """The config a run trains on, or the first of its mixture or schedule: the one its directory is named after
+    and its eval configs are certified against."""
+    return schedule.distinct_configs(stages_of(args))[0]
 
 
 def with_config_files(args: Args) -> Args:
     """`args` with each shipped config's name (kage_bench/bases/shape_black) replaced by its installed file, so
     that every later step, run.json included, sees one path."""
-    return dataclasses.replace(args, train_config_path=config_file(args.train_config_path),
+    return dataclasses.replace(args, train_config_path=args.train_config_path and config_file(args.train_config_path),
+                               train_config_paths=[config_file(p) for p in args.train_config_paths],
                                eval_config_path=args.eval_config_path and config_file(args.eval_config_path),
                                eval_config_paths=[config_file(p) for p in args.eval_config_paths])
 
@@ -297,4 +339,9 @@ def eval_labels(args: Args) -> List[str]:
     labels = args.eval_config_labels or [os.path.basename(p.rstrip("/")).replace(" ", "_") for p in eval_paths(args)]
     if len(set(labels)) != len(labels):
         raise SystemExit(f"kage.ppo.train: eval configs share a label ({labels}); name them with --eval-config-labels")
+    training = {training_label(i) for i in range(len(schedule.distinct_configs(stages_of(args))))}
+    taken = [label for label in labels if label in training]
+    if taken:
+        raise SystemExit(f"kage.ppo.train: eval config label {taken[0]!r} is a training config's label: name the eval "
+                         "configs otherwise with --eval-config-labels")
     return labels

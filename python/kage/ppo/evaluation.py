@@ -75,7 +75,7 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
     after the waves (and steps on, a wave at a time, if one fell short)."""
     device = next(agent.parameters()).device
     flat_envs = [e for run in envs for e in run]
-    specs = [env.resolved_spec["config"] for env in flat_envs]
+    specs = [env.resolved_specs[0]["config"] for env in flat_envs]  # the hidden game's: a mixture's configs share it
     episode_length = max(c["episode_length"] for c in specs)
     configs, n, num_actions = len(envs[0]), flat_envs[0].num_envs, flat_envs[0].single_action_space.n
     random = CounterRandom([s for run in seeds for s in run], device)

@@ -1,7 +1,9 @@
 """A training run's directory: what it was trained on, its log, its checkpoint and its summary.
 
-    DIR/run.json                 arguments, code version, the configs' labels, paths and spec hashes
-    DIR/configs/<label>.json     every config's resolved Spec (kagec resolve); "train" is the train config
+    DIR/run.json                 arguments, code version, the configs' labels, paths and spec hashes, and for a
+                                 mixture or schedule its stages (start, configs by label, weights)
+    DIR/configs/<label>.json     every config's resolved Spec (kagec resolve); "train" is the train config (the
+                                 first of a mixture or schedule, whose others are "train.1", "train.2", ...)
     DIR/certificates/<label>.json  the train/eval pair's certificate (kagec diff --certify)
     DIR/metrics.jsonl            one row per iteration ("kind": "train") and per evaluation ("kind": "eval")
     DIR/checkpoints/latest.pt    parameters, optimizer, random streams, environments' state, loop state: data
@@ -37,13 +39,15 @@ import torch
 from kage import front_end, resources
 from kage.errors import ConfigError
 from kage.fields import SUCCESS_SHOWN
-from kage.ppo import checkpoint, plugins
+from kage.ppo import checkpoint, plugins, schedule
+from kage.ppo.args import configs_of, first_train_config, stages_of, training_label
 from kage.util.files import atomic_write, named_errors, read_json_record, remove_strays, safe, write_json
 from kage.util.lock import DirectoryLock, LockHeld
 
 _RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
 # Arguments added since runs were first written, with the value that means what a run without them did.
-_ADDED_ARGUMENTS = {"agent": "kage.ppo.agent:nature_cnn", "augment": None, "video_every": 0, "drac_coef": 0.1}
+_ADDED_ARGUMENTS = {"agent": "kage.ppo.agent:nature_cnn", "augment": None, "video_every": 0, "drac_coef": 0.1,
+                    "train_config_paths": [], "train_weights": [], "train_schedule": None}
 
 
 def code_version() -> str:
@@ -69,7 +73,12 @@ def json_args(args) -> dict:
 
 
 def default_dir(args) -> str:
-    stem = os.path.splitext(os.path.basename(args.train_config_path.rstrip("/")))[0]
+    """runs/<exp-name>__<stem>__<seed>: the stem of the train config, of a schedule file, or of a mixture's first
+    config followed by +<number of configs>."""
+    named = args.train_schedule or first_train_config(args)
+    stem = os.path.splitext(os.path.basename(named.rstrip("/")))[0]
+    if args.train_config_paths and len(args.train_config_paths) > 1:
+        stem += f"+{len(args.train_config_paths)}"
     return os.path.join("runs", f"{args.exp_name}__{stem}__{args.seed}")
 
 
@@ -123,6 +132,7 @@ class RunDir:
         first) whose resolved Specs are `specs`: locked, then created with its description, or checked against it."""
         path = args.out or default_dir(args)
         described = {label: {"path": config, "spec_sha256": specs[label]["sha256"]} for label, config in configs}
+        stages = stages_description(args)
         os.makedirs(path, exist_ok=True)
         lock = DirectoryLock(path, "run", "kage.ppo.train")
         try:
@@ -130,11 +140,11 @@ class RunDir:
         except LockHeld as e:
             raise SystemExit(f"kage.ppo.train: {e}") from None
         try:
-            describe_or_check(path, args, configs, specs, described)
+            describe_or_check(path, args, configs, specs, described, stages)
         except BaseException:
             lock.release()
             raise
-        return cls(path, specs, lock, {"args": json_args(args), "configs": described})
+        return cls(path, specs, lock, {"args": json_args(args), "configs": described, "stages": stages})
 
 
     # ---- the log ----
@@ -229,6 +239,8 @@ class RunDir:
             before = recorded["configs"].get(label)
             if before != now:
                 problems.append(f"config {label}: {before} in the checkpoint, {now} now")
+        if recorded.get("stages") != self.identity["stages"]:
+            problems.append(f"stages: {recorded.get('stages')} in the checkpoint, {self.identity['stages']} now")
         if problems:
             raise SystemExit(f"kage.ppo.train: {path} belongs to another run ({'; '.join(problems)}): restore this "
                              "run's checkpoint, or train anew with another --out")
@@ -242,10 +254,20 @@ class RunDir:
         write_json(os.path.join(self.path, "summary.json"), summarize(history))
 
 
-def check_env(specs: Dict[str, dict], label: str, env) -> None:
-    """Refuses a batch that runs another Spec than the one resolved for `label` (its config file changed between
-    the two reads)."""
-    recorded = specs[label]["sha256"]
+def stages_description(args) -> Optional[List[dict]]:
+    """A mixture's or schedule's stages as run.json records them (each config by its label), None for one config."""
+    stages = stages_of(args)
+    if not schedule.is_mixture(stages):
+        return None
+    label_of = {path: training_label(i) for i, path in enumerate(schedule.distinct_configs(stages))}
+    return [dict(stage.describe(), configs=[label_of[c] for c in stage.configs]) for stage in stages]
+
+
+def check_env(specs: Dict[str, dict], labels: List[str], env) -> None:
+    """Refuses a batch that runs other Specs than those resolved for `labels` (its configs, one unless a
+    mixture: a config file changed between the two reads)."""
+    hashes = [specs[label]["sha256"] for label in labels]
+    recorded = hashes[0] if isinstance(env.config, str) else front_end.mixture_hash(hashes, env.counts)
     if env.spec_hash != recorded:
         raise SystemExit(f"kage.ppo.train: config '{env.config}' ({label}) changed while the run was being opened "
                          f"(spec {recorded[:12]} resolved, {env.spec_hash[:12]} in the environment): run again")
@@ -269,7 +291,8 @@ def resolve_configs(configs: List[Tuple[str, str]], asset_root: Optional[str]) -
 def check_finished(path: str, args, configs: List[Tuple[str, str]]) -> None:
     """Refuses a finished run's directory to other arguments or changed configs, as a resume would (reads only)."""
     previous = read_run_json(os.path.join(path, "run.json"))
-    check_same_run(path, previous, json_args(args), resolve_configs(configs, args.asset_root)[1])
+    check_same_run(path, previous, json_args(args), resolve_configs(configs, args.asset_root)[1],
+                   stages_description(args))
 
 
 def read_run_json(path: str) -> dict:
@@ -292,14 +315,14 @@ def run_json_problem(run) -> Optional[str]:
 
 
 def describe_or_check(path: str, args, configs: List[Tuple[str, str]], specs: Dict[str, dict],
-                      described: Dict[str, dict]) -> None:
+                      described: Dict[str, dict], stages: Optional[List[dict]]) -> None:
     """Under the run's lock: a new run's description written (run.json last), or an existing one checked against
     `args` and `described`; dead writers' temporary files removed."""
     for folder in ("", "configs", "certificates", "checkpoints", "videos"):
         remove_strays(os.path.join(path, folder))  # a killed writer's, or one that met a full disk
     run_json = os.path.join(path, "run.json")
     if os.path.exists(run_json):
-        check_same_run(path, read_run_json(run_json), json_args(args), described)
+        check_same_run(path, read_run_json(run_json), json_args(args), described, stages)
         return
     log = os.path.join(path, "metrics.jsonl")
     if os.path.exists(os.path.join(path, "checkpoints", "latest.pt")) or (os.path.exists(log) and os.path.getsize(log)):
@@ -308,13 +331,14 @@ def describe_or_check(path: str, args, configs: List[Tuple[str, str]], specs: Di
     os.makedirs(os.path.join(path, "configs"), exist_ok=True)
     os.makedirs(os.path.join(path, "certificates"), exist_ok=True)
     os.makedirs(os.path.join(path, "checkpoints"), exist_ok=True)
+    training = schedule.distinct_configs(stages_of(args))
     for label, config in configs:
         write_json(os.path.join(path, "configs", f"{safe(label)}.json"), specs[label])
-        if label != "train":
-            certificate = front_end.certify(args.train_config_path, config, args.asset_root)
+        if label not in {training_label(i) for i in range(len(training))}:
+            certificate = front_end.certify(first_train_config(args), config, args.asset_root)
             write_json(os.path.join(path, "certificates", f"{safe(label)}.json"), certificate)
     write_json(run_json, {
-        "kage_run": 1, "args": json_args(args), "argv": sys.argv, "configs": described,
+        "kage_run": 1, "args": json_args(args), "argv": sys.argv, "configs": described, "stages": stages,
         "code_version": code_version(), "python": sys.version.split()[0], "torch": torch.__version__,
         "device_name": torch.cuda.get_device_name() if args.device == "cuda" and torch.cuda.is_available()
         else "cpu", "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
@@ -435,8 +459,8 @@ def with_augment_mode(args):
     return dataclasses.replace(args, augment_mode=mode)
 
 
-def check_same_run(path: str, previous: dict, args: dict, configs: dict) -> None:
-    """Refuses to resume `path` with other arguments or with configs whose Spec changed."""
+def check_same_run(path: str, previous: dict, args: dict, configs: dict, stages: Optional[List[dict]]) -> None:
+    """Refuses to resume `path` with other arguments, with configs whose Spec changed, or with other stages."""
     for label, now in configs.items():
         before = previous["configs"].get(label)
         if before is None or before["path"] != now["path"]:
@@ -446,6 +470,9 @@ def check_same_run(path: str, previous: dict, args: dict, configs: dict) -> None
                 f"kage.ppo.train: config '{now['path']}' ({label}) changed since {path} started (spec "
                 f"{before['spec_sha256'][:12]} then, {now['spec_sha256'][:12]} now): restore it, or start a new run "
                 "with another --out")
+    if previous.get("stages") != stages:
+        raise SystemExit(f"kage.ppo.train: {path} was started with other training stages ({previous.get('stages')} "
+                         f"then, {stages} now): restore the schedule or weights, or use another --out")
     changed = changed_arguments(previous["args"], args)
     if changed:
         details = ", ".join(f"{k}: {before!r} then, {args[k]!r} now" for k, before in changed)

@@ -8,6 +8,7 @@ import sys
 from typing import Dict, Optional
 
 from kage.fields import BOARD_DIFF, BOARD_SIDE, BY_NAME, DIFF_METRICS, LISTED, RECORD
+from kage.ppo.args import first_train_config
 
 # The original's copies of two training-row tags, under its own names.
 TRAIN_COPIES = {"train/avg_progress": "main_metrics/avg_train_progress",
@@ -129,5 +130,5 @@ def open_writer(run_dir: str, args):
                   file=sys.stderr)
             _told = True
         return NoBoard()
-    train_label = os.path.basename(args.train_config_path.rstrip("/")).replace(" ", "_")  # §3.5's labels
+    train_label = os.path.basename(first_train_config(args).rstrip("/")).replace(" ", "_")  # §3.5's labels
     return Board(os.path.join(run_dir, "tensorboard"), writer_class, train_label, dataclasses.asdict(args))

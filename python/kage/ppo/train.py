@@ -3,6 +3,10 @@ on one or more others, as the original's ppo_jax.py (and ppo_jax_multi_conf.py) 
 
     python3 -m kage.ppo.train --train-config-path T --eval-config-path E --seed S [--device cuda|cpu] [--out DIR]
 
+Not in the original: train on a mixture of configs (--train-config-paths A B C [--train-weights ...]: one batch
+split across them) or on a schedule of mixtures (--train-schedule FILE), kage.ppo.schedule; the evaluation's
+"train" target is then the current stage's mixture.
+
 Read it top to bottom like CleanRL's ppo_atari_envpool.py: train() is the loop (rollout, GAE, update, log),
 and each other concern is a function of its own below it (the pack's runs, resume and checkpoints, the
 evaluation points, the log rows). The flags are kage.ppo.args, the losses kage.ppo.losses, the network
@@ -46,10 +50,12 @@ from typing import Dict, List, Optional
 import torch
 
 import kage
+from kage import front_end
+from kage.errors import ConfigError
 from kage.fields import EPISODE_METRICS as METRICS
-from kage.ppo import checkpoint, plugins, rundir, tensorboard_log, video
+from kage.ppo import checkpoint, plugins, rundir, schedule, tensorboard_log, video
 from kage.ppo.agent import frames_at
-from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args
+from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args, stages_of
 from kage.ppo.counter_random import CounterRandom
 from kage.ppo.evaluation import EpisodeMetrics, EvalSettings, EvalTargets, evaluation_rows
 from kage.ppo.losses import (clip_grad_norm_per_run, compute_gae, drac_regularisers, entropy_coefficient, entropy_of,
@@ -116,14 +122,11 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     actions = torch.zeros((T, K, N), dtype=torch.long, device=device)
     logprobs, rewards, dones, values = (torch.zeros((T, K, N), device=device) for _ in range(4))
 
-    # Views of the runtime's buffers, which every step rewrites in place.
-    infos = [run.env.reset(seed=kage.env_seeds(run.args.seed, N))[1] for run in runs]
-    outputs = [run.env.outputs() for run in runs]
-    frames = [torch.from_dlpack(o[0]) for o in outputs]
-    env_reward, env_terminated, env_truncated = ([torch.from_dlpack(o[i]) for o in outputs] for i in (1, 2, 3))
-    final_frames = [torch.from_dlpack(info["final_obs"]) for info in infos]
-    specs = [run.env.resolved_spec["config"] for run in runs]
-    episode = EpisodeMetrics(infos, [spec["dist_to_success"] for spec in specs], device)
+    for run in runs:
+        run.env.reset(seed=kage.env_seeds(run.args.seed, N))
+    views = BatchViews(runs, device)  # views of the runtime's buffers, which every step rewrites in place
+    frames, env_reward, env_terminated, env_truncated = views.frames, views.reward, views.terminated, views.truncated
+    specs = [run.env.resolved_specs[0]["config"] for run in runs]  # the hidden game's: a mixture's configs share it
     stack = FrameStack(torch.stack(frames)) if args.use_frame_stack else None
     normalizer = RewardNormalizer((K, N), args.gamma, device) if args.normalize_reward else None
     state = LoopState.start(K, N, device)
@@ -133,7 +136,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         """The runs' current observations, [K, N, H, W, C]."""
         return stack.stack if stack else torch.stack(frames)
 
-    if resume(runs, agent, optimizer, state, stack, normalizer, boards, device, agent_spec):
+    if resume(runs, agent, optimizer, state, stack, normalizer, boards, device, agent_spec, views, threads):
         pass
     elif runs[0].eval_envs:
         with timer("eval"):  # §3.1: the untrained policy
@@ -155,6 +158,15 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
 
     for iteration in range(start_iteration, last_iteration + 1):
         iteration_start = time.perf_counter()
+        for k, run in enumerate(runs):  # a schedule's stage boundary: the run's batches for the new mixture
+            if schedule.stage_at(run.stages, iteration) != run.stage:
+                enter_stage(run, schedule.stage_at(run.stages, iteration), threads, reset=True)
+                views.bind(k, run.env)
+                state.next_done[k] = 1.0  # the episodes under way end here
+                if stack:
+                    stack.restart(k, frames[k])
+                if normalizer:
+                    normalizer.ret[k] = 0.0
         if args.anneal_lr:  # §2.6
             optimizer.param_groups[0]["lr"] = args.learning_rate * (1.0 - (iteration - 1.0) / args.num_iterations)
         episode_sums = torch.zeros((K, len(METRICS) + 1), device=device)  # count, then the nine metrics
@@ -180,13 +192,13 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                     run.env.step(a)
                 reward = torch.stack(env_reward)
                 state.next_done = (torch.stack(env_terminated) | torch.stack(env_truncated)).float()  # QUIRK (§2.5 b)
-                finished = finished_at[step] = episode.mask()
+                finished = finished_at[step] = views.episode.mask()
                 if not read_once:
-                    episode_sums += state.tally(episode.rows(), finished)
+                    episode_sums += state.tally(views.episode.rows(), finished)
                 if args.bootstrap_truncation:
                     with torch.no_grad(), autocast(args.bf16):  # the value of the observation the truncation discarded
                         truncated = torch.stack(env_truncated).float() * finished
-                        final = torch.stack(final_frames)
+                        final = torch.stack(views.final_frames)
                         if stack:  # the final frame on top of the episode's last stack
                             final = torch.cat([stack.stack[..., final.shape[-1]:], final], -1)
                         if augment_rollout:
@@ -199,7 +211,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                     stack.push(torch.stack(frames), state.next_done)
         if read_once:
             with timer("env"):
-                episode_sums += state.tally(episode.rows(), finished_at.sum(0))
+                episode_sums += state.tally(views.episode.rows(), finished_at.sum(0))
         state.global_step += args.batch_size  # §2.5 step 2
 
         with torch.no_grad(), timer("forward"):  # §2.5 step 3
@@ -311,21 +323,89 @@ class Run:
     """What a run owns besides its slice of the network: its arguments, directory and environments."""
     args: Args
     specs: Dict[str, dict]  # each config's resolved Spec, by label
-    env: "kage.VecEnv"
-    eval_envs: Dict[str, "kage.VecEnv"]  # "train", then the eval configs by label
+    stages: List[schedule.Stage]  # what it trains on (one stage of one config, unless a mixture or schedule)
+    labels: Dict[str, str]  # each training config's label, by path
+    env: Optional["kage.VecEnv"] = None  # the training batch of stage `stage`
+    eval_envs: Dict[str, "kage.VecEnv"] = field(default_factory=dict)  # "train", then the eval configs by label
+    stage: int = 0
     dir: Optional[rundir.RunDir] = None  # opened once everything that can be refused was checked
     history: List[dict] = field(default_factory=list)
 
 
 def open_batches(args: Args, threads: int) -> Run:
-    """The run's configs resolved and its batches made, each checked to run the resolved Spec; nothing written."""
-    specs = rundir.resolve_configs(configs_of(args), args.asset_root)[0]
-    env = make_batch(specs, "train", args.train_config_path, args.num_envs, "--num-envs", args, threads, seed=args.seed)
-    eval_envs = {}
+    """The run's configs resolved (and certified as one mixture where it trains on several) and its batches made
+    for its first stage, each checked to run the resolved Specs; nothing written."""
+    stages = stages_of(args)
+    configs = configs_of(args)
+    specs = rundir.resolve_configs(configs, args.asset_root)[0]
+    if schedule.is_mixture(stages):
+        try:
+            schedule.check_iterations(stages, args.num_iterations, args.train_schedule or "--train-config-paths")
+            front_end.certify_mixture(schedule.distinct_configs(stages), args.asset_root)
+        except schedule.ScheduleError as e:
+            raise SystemExit(f"kage.ppo.train: {e}") from None
+        except ConfigError as e:  # kagec's located line names the key, both files and the rule
+            raise SystemExit(str(e)) from None
+    run = Run(args, specs, stages, {path: label for label, path in configs[:len(schedule.distinct_configs(stages))]})
+    run.env = stage_batch(run, 0, args.num_envs, "--num-envs", threads, seed=args.seed)
     if args.run_eval_every > 0 and args.eval_episodes > 0 and args.eval_num_envs > 0:
-        for label, path in configs_of(args):
-            eval_envs[label] = make_batch(specs, label, path, args.eval_num_envs, "--eval-num-envs", args, threads)
-    return Run(args, specs, env, eval_envs)
+        run.eval_envs["train"] = stage_batch(run, 0, args.eval_num_envs, "--eval-num-envs", threads)
+        for label, path in configs[len(run.labels):]:
+            run.eval_envs[label] = make_batch(specs, label, path, args.eval_num_envs, "--eval-num-envs", args, threads)
+    return run
+
+
+def stage_batch(run: Run, stage: int, num_envs: int, flag: str, threads: int, **seed) -> "kage.VecEnv":
+    """A batch of `num_envs` environments of the run's stage `stage`: its one config, or the mixture of its configs
+    by its weights (a mixture whenever the run trains on more than one config)."""
+    configs, weights = run.stages[stage].configs, run.stages[stage].weights
+    if not schedule.is_mixture(run.stages):
+        return make_batch(run.specs, "train", configs[0], num_envs, flag, run.args, threads, **seed)
+    label = "stage " + str(stage + 1) if run.args.train_schedule else "train"
+    try:
+        env = kage.make_vec(list(configs), num_envs, device=run.args.device, asset_root=run.args.asset_root,
+                            threads=threads, weights=weights, **seed)
+    except (ValueError, RuntimeError, OSError) as e:
+        raise SystemExit(f"kage.ppo.train: the mixture of {', '.join(configs)} ({label}, {flag} {num_envs}): {e}") \
+            from None
+    rundir.check_env(run.specs, [run.labels[c] for c in configs], env)
+    return env
+
+
+def enter_stage(run: Run, stage: int, threads: int, reset: bool) -> None:
+    """Replaces the run's training batch (and its evaluation's "train" batch) with stage `stage`'s; `reset`: starts
+    their episodes with the stage's seeds (a resume loads the checkpoint's state instead)."""
+    args = run.args
+    run.env.close()
+    run.env = stage_batch(run, stage, args.num_envs, "--num-envs", threads)
+    if reset:
+        run.env.reset(seed=kage.env_seeds(schedule.stage_seed(args.seed, stage), args.num_envs))
+    if "train" in run.eval_envs:
+        run.eval_envs["train"].close()
+        run.eval_envs["train"] = stage_batch(run, stage, args.eval_num_envs, "--eval-num-envs", threads)
+    run.stage = stage
+
+
+class BatchViews:
+    """Device views of the outputs of each run's training batch, which every step rewrites in place: the frames,
+    rewards and flags as lists over the runs, the final frames, and the finished episodes' metrics."""
+
+    def __init__(self, runs: List[Run], device):
+        self.device = device
+        self.dists_to_success = [run.env.resolved_specs[0]["config"]["dist_to_success"] for run in runs]
+        self.frames, self.reward, self.terminated, self.truncated, self.final_frames, self.infos = \
+            ([None] * len(runs) for _ in range(6))
+        for k, run in enumerate(runs):
+            self.bind(k, run.env)
+
+    def bind(self, k: int, env: "kage.VecEnv") -> None:
+        """Views of run k's batch `env` (a new one at a stage boundary), in place of its earlier ones."""
+        obs, reward, terminated, truncated, info = env.outputs()
+        self.frames[k], self.reward[k] = torch.from_dlpack(obs), torch.from_dlpack(reward)
+        self.terminated[k], self.truncated[k] = torch.from_dlpack(terminated), torch.from_dlpack(truncated)
+        self.final_frames[k], self.infos[k] = torch.from_dlpack(info["final_obs"]), info
+        if all(i is not None for i in self.infos):
+            self.episode = EpisodeMetrics(self.infos, self.dists_to_success, self.device)
 
 
 def make_batch(specs: Dict[str, dict], label: str, path: str, num_envs: int, flag: str, args: Args, threads: int,
@@ -336,7 +416,7 @@ def make_batch(specs: Dict[str, dict], label: str, path: str, num_envs: int, fla
         env = kage.make_vec(path, num_envs, device=args.device, asset_root=args.asset_root, threads=threads, **seed)
     except (ValueError, RuntimeError, OSError) as e:
         raise SystemExit(f"kage.ppo.train: config '{path}' ({label}, {flag} {num_envs}): {e}") from None
-    rundir.check_env(specs, label, env)
+    rundir.check_env(specs, [label], env)
     return env
 
 
@@ -543,7 +623,7 @@ def checkpoint_problem(c: dict, k: int, run: Run, agent, state: LoopState, stack
 
 
 def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalizer, boards, device,
-           agent_spec: dict) -> bool:
+           agent_spec: dict, views: BatchViews, threads: int) -> bool:
     """Loads the runs' checkpoints, if they have any, into the network, optimizer, environments and loop state;
     whether they had."""
     checkpoints = [run.dir.load_checkpoint() for run in runs]
@@ -562,6 +642,10 @@ def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalize
         with torch.no_grad():
             for name, p in agent.named_parameters():
                 agent.run_view(p)[k].copy_(c["agent"][name])
+        stage = schedule.stage_at(run.stages, c["iteration"])
+        if stage != run.stage:  # the checkpoint's environments are those of the stage it was written in
+            enter_stage(run, stage, threads, reset=False)
+            views.bind(k, run.env)
         run.env.load_state(c["env_state"])
         for key in LoopState.TENSORS:
             getattr(state, key)[k] = c[key].to(device)

@@ -15,6 +15,10 @@ class FrameStack:
     def _refill(self, frame: torch.Tensor) -> torch.Tensor:
         return frame.repeat(*[1] * (frame.dim() - 1), self.frames)
 
+    def restart(self, index: int, frame: torch.Tensor) -> None:
+        """Refills stack `index` (of the leading axis) with `frame`: its environments start anew."""
+        self.stack[index] = self._refill(frame)
+
     def push(self, frame: torch.Tensor, done: torch.Tensor) -> torch.Tensor:
         """Appends `frame`; `done` ([...], 0/1) marks the environments whose episode just ended."""
         c = frame.shape[-1]
