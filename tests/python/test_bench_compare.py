@@ -134,7 +134,7 @@ def test_refuses_other_seeds(two, tmp_path):
     a, _ = two
     fewer = method(tmp_path / "D", {"background/1": [0.1, 0.2]}, seeds=(1, 2))
     with pytest.raises(SystemExit,
-                       match=r"have other seeds \(\[1, 2, 3\] and \[1, 2\]\): run both with the same --seeds, or "
+                       match=r"have other seeds \(1-3 and 1-2\): run both with the same --seeds, or "
                              r"compare the seeds they share with --seeds 1-2$"):
         compare.compare([str(a), str(fewer)], reps=100)
 

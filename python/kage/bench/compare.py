@@ -110,9 +110,10 @@ def load(bench_dir: str, name: str, protocol: str) -> Method:
              + (f"; its {unfinished} runs are still training or stopped" if unfinished else "") +
              f": compare reads finished runs only: let them finish (kage.bench status {bench_dir}), or compare "
              "other directories")
+    ran = {p["pair"] for u in units if not u.is_sweep for p in u.pairs}
     return Method(name, bench_dir, suite, sorted(seeds), json.loads(schedules.pop()) if schedules else {}, units,
                   runs, {(r["pair"], r["seed"]) for r in levels["runs"]},
-                  {p["pair"]: p for u in units if not u.is_sweep for p in u.pairs})
+                  {p["pair"]: p for p in suite["pairs"] if p["pair"] in ran})
 
 
 def choose_seeds(methods: List[Method], wanted: Optional[List[int]]) -> List[int]:
@@ -124,8 +125,8 @@ def choose_seeds(methods: List[Method], wanted: Optional[List[int]]) -> List[int
             if other.seeds != first.seeds:
                 shared = sorted(set(first.seeds) & set(other.seeds))
                 hint = f", or compare the seeds they share with --seeds {seeds_text(shared)}" if shared else ""
-                fail(f"{first.bench_dir} and {other.bench_dir} have other seeds ({first.seeds} and {other.seeds}): "
-                     f"run both with the same --seeds{hint}")
+                fail(f"{first.bench_dir} and {other.bench_dir} have other seeds ({seeds_text(first.seeds)} and "
+                     f"{seeds_text(other.seeds)}): run both with the same --seeds{hint}")
         return first.seeds
     for m in methods:
         missing = [s for s in wanted if s not in m.seeds]
