@@ -1,7 +1,9 @@
 """kage.bench compare: two benchmark directories side by side (IQMs with intervals, P(X > Y), the overlaid
 plots), on hand-made directories with values worked out here and end to end on two tiny CPU benchmarks (the
-baseline and the random-shift agent); that it compares only the (pair, seed) results every directory has; and
-its refusals of directories whose suite, seeds or protocol differ."""
+baseline and the random-shift agent); that it compares only the pairs every directory ran (or --pairs), the
+seeds of --seeds and the (pair, seed) results every directory has; that a method may train otherwise; --max-step
+against values recomputed from the rows; and its refusals of directories whose eval configs, seeds or protocol
+differ."""
 import csv
 import json
 import shutil
@@ -10,6 +12,8 @@ import pytest
 from test_bench_e2e import TINY, bench as bench_cli, run as run_tiny
 from test_report import PNG_SIGNATURE, pair, plain, write_run
 from test_report_intervals import rows_for, write_suite
+
+from test_report_intervals import full_row
 
 from kage.bench import compare
 
@@ -84,16 +88,45 @@ def test_three_methods_give_each_two(two, tmp_path):
 
 # ---- refusals ----
 
-def test_refuses_another_suite(two):
+def test_a_method_may_train_otherwise_but_must_evaluate_alike(two):
+    """B trains background/1 on a mixture: compared, and compare.md says what each trains on; B evaluating
+    background/1 on another Spec is refused, naming the pair."""
     a, b = two
     suite = json.loads((b / "suite.json").read_text())
+    suite["pairs"][0]["train"] = {"name": "mixture of 2", "spec_sha256": "dd", "schedule": None, "stages": [
+        {"start": 0, "configs": [{"name": "configs/x.yaml", "spec_sha256": "aa", "weight": 0.5},
+                                 {"name": "configs/y.yaml", "spec_sha256": "ee", "weight": 0.5}]}]}
+    (b / "suite.json").write_text(json.dumps(suite))
+    result = compare.compare([str(a), str(b)], reps=500)
+    methods = {m["name"]: m for m in result["methods"]}
+    assert methods["A"]["trains_on"] == [{"name": "1-train.yaml", "pairs": ["background/1", "layout/1"]},
+                                         {"name": "2-train.yaml", "pairs": ["background/2"]}]
+    assert methods["B"]["trains_on"] == [{"name": "mixture of 2", "pairs": ["background/1"]},
+                                         {"name": "2-train.yaml", "pairs": ["background/2"]},
+                                         {"name": "1-train.yaml", "pairs": ["layout/1"]}]
+    assert methods["B"]["training"] == {"background/1": "dd", "background/2": "aa", "layout/1": "aa"}
+    estimates = {m["name"]: {r["name"]: r for r in m["estimates"]["rows"]} for m in result["methods"]}
+    assert estimates["B"]["background"]["eval_iqm"]["point"] == pytest.approx(0.2)  # as in test_compare_by_hand
+    md = (a / "compare" / "compare.md").read_text()
+    assert ("Trains on: **A** 1-train.yaml (2 pairs), 2-train.yaml (1 pair); **B** mixture of 2 (1 pair), "
+            "2-train.yaml (1 pair), 1-train.yaml (1 pair). The methods train differently") in md
     suite["pairs"][0]["eval"]["spec_sha256"] = "cc"
     (b / "suite.json").write_text(json.dumps(suite))
-    with pytest.raises(SystemExit, match=r"are not of the same suite: background/1's eval config has another Spec "
-                                         r"\(spec_sha256 bb and cc\)"):
+    with pytest.raises(SystemExit, match=r"^kage.bench compare: .*A and .*B evaluate background/1 on other configs "
+                                         r"\(eval spec_sha256 bb and cc\): compare methods evaluated on the same "
+                                         r"configs, or leave background/1 out with --pairs$"):
         compare.compare([str(a), str(b)], reps=100)
-    (b / "suite.json").write_text(json.dumps({**suite, "pairs": suite["pairs"][1:]}))
-    with pytest.raises(SystemExit, match=r"pairs only in .*A: background/1"):
+    result = compare.compare([str(a), str(b)], pairs=["background/2", "layout/1"], reps=100)
+    assert result["pairs"] == ["background/2", "layout/1"] and result["results_compared"] == 6
+
+
+def test_refuses_a_pair_on_another_axis(two):
+    a, b = two
+    suite = json.loads((b / "suite.json").read_text())
+    suite["pairs"][2]["declared_axis"] = "background"
+    (b / "suite.json").write_text(json.dumps(suite))
+    with pytest.raises(SystemExit, match=r"put layout/1 on other axes \(layout and background\): compare suites that "
+                                         r"agree on the pair's axis, or leave layout/1 out with --pairs"):
         compare.compare([str(a), str(b)], reps=100)
 
 
@@ -101,13 +134,36 @@ def test_refuses_other_seeds(two, tmp_path):
     a, _ = two
     fewer = method(tmp_path / "D", {"background/1": [0.1, 0.2]}, seeds=(1, 2))
     with pytest.raises(SystemExit,
-                       match=r"have other seeds \(\[1, 2, 3\] and \[1, 2\]\): run both with the same --seeds"):
+                       match=r"have other seeds \(1-3 and 1-2\): run both with the same --seeds, or "
+                             r"compare the seeds they share with --seeds 1-2$"):
         compare.compare([str(a), str(fewer)], reps=100)
+
+
+def test_seeds_compares_a_subset(two, tmp_path):
+    """A ran seeds 1-3, D seeds 1-2: --seeds 1-2 compares those; a seed that D lacks is refused, naming D."""
+    a, _ = two
+    d = method(tmp_path / "D", {"background/1": [0.1, 0.6], "background/2": [0.4, 0.1], "layout/1": [0.0, 0.1]},
+               seeds=(1, 2))
+    result = compare.compare([str(a), str(d)], seeds=[1, 2], reps=500)
+    assert result["seeds"] == [1, 2] and result["seeds_chosen"] and result["results_compared"] == 6
+    methods = {m["name"]: m for m in result["methods"]}
+    assert methods["A"]["results_finished"] == 6 and methods["A"]["left_out"] == []
+    estimates = {m["name"]: {r["name"]: r for r in m["estimates"]["rows"]} for m in result["methods"]}
+    # A's background eval, seeds 1 and 2: 0.2 0.3 0.5 0.6, one cut at each end: IQM 0.4; D's 0.1 0.1 0.4 0.6 -> 0.25
+    assert estimates["A"]["background"]["eval_iqm"]["point"] == pytest.approx(0.4)
+    assert estimates["D"]["background"]["eval_iqm"]["point"] == pytest.approx(0.25)
+    assert {r["n_runs"] for m in result["methods"] for r in m["estimates"]["rows"] if r["name"] == "layout"} == {2}
+    assert "Seeds 1-2 (--seeds);" in (a / "compare" / "compare.md").read_text()
+    with pytest.raises(SystemExit, match=r"^kage.bench compare: .*D has no seed 3 \(its seeds are 1-2\): give --seeds "
+                                         r"that every directory has"):
+        compare.compare([str(a), str(d)], seeds=[2, 3], reps=100)
+    with pytest.raises(SystemExit, match=r"^kage.bench compare: --seeds '2-1': the range 2-1 is empty$"):
+        compare.main([str(a), str(d), "--seeds", "2-1"])
 
 
 def test_compares_the_results_every_method_has(two):
     """B ran two of the three pairs (run --pairs) and its seed 3 is still training: both are compared on seeds 1
-    and 2 of background/1 and 2, and compare.md names what A has beyond them."""
+    and 2 of background/1 and 2, and compare.md names the pair and the results that A has beyond them."""
     a, b = two
     bench = json.loads((b / "bench.json").read_text())
     (b / "bench.json").write_text(json.dumps({**bench, "units": ["background/1", "background/2"]}))
@@ -116,10 +172,11 @@ def test_compares_the_results_every_method_has(two):
         (b / "runs" / name / "seed_3" / "summary.json").unlink()
     result = compare.compare([str(a), str(b)], reps=500)
     assert result["results_compared"] == 4
+    assert result["pairs"] == ["background/1", "background/2"] and not result["pairs_chosen"]
     methods = {m["name"]: m for m in result["methods"]}
-    assert methods["A"]["results_finished"] == 9 and methods["B"]["results_finished"] == 4
-    assert methods["A"]["left_out"] == [{"pair": "background/1", "seed": 3}, {"pair": "background/2", "seed": 3},
-                                        *({"pair": "layout/1", "seed": s} for s in (1, 2, 3))]
+    assert methods["A"]["pairs_left_out"] == ["layout/1"] and methods["B"]["pairs_left_out"] == []
+    assert methods["A"]["results_finished"] == 6 and methods["B"]["results_finished"] == 4
+    assert methods["A"]["left_out"] == [{"pair": "background/1", "seed": 3}, {"pair": "background/2", "seed": 3}]
     assert methods["B"]["left_out"] == []
     estimates = {m["name"]: {r["name"]: r for r in m["estimates"]["rows"]} for m in result["methods"]}
     # A's background eval, seeds 1 and 2: 0.2 0.3 0.5 0.6, one cut at each end: IQM 0.4; B's 0.1 0.1 0.4 0.6 -> 0.25
@@ -131,8 +188,39 @@ def test_compares_the_results_every_method_has(two):
     assert p[("background", "A", "B")]["p"]["point"] == pytest.approx((2.5 / 4 + 2 / 4) / 2)
     assert {name for name, _, _ in p} == {r["name"] for r in estimates["A"].values()} == {"background", "all pairs"}
     md = (a / "compare" / "compare.md").read_text()
+    assert "2 pairs, those every directory ran; left out, run by some methods only: **A** 1: layout/1;" in md
     assert ("Compared on the 4 (pair, seed) results that every method has finished; left out, finished by some "
-            "methods only: **A** 5: background/1 (seed 3), background/2 (seed 3), layout/1 (3 seeds).") in md
+            "methods only: **A** 2: background/1 (seed 3), background/2 (seed 3).") in md
+
+
+def test_pairs_chooses_the_pairs_compared(two):
+    a, b = two
+    result = compare.compare([str(a), str(b)], pairs=["layout/1", "background/1"], reps=500)
+    assert result["pairs"] == ["background/1", "layout/1"] and result["pairs_chosen"]  # in the suite's order
+    assert result["results_compared"] == 6
+    assert {r["name"] for r in result["methods"][0]["estimates"]["rows"]} == {"background", "layout", "all pairs"}
+    assert result["methods"][0]["pairs_left_out"] == []
+    p = {(r["name"], r["x"], r["y"]): r for r in result["improvement"]}
+    assert p[("background", "A", "B")]["p"]["point"] == pytest.approx(7.5 / 9)  # background/1 alone, as by hand
+    assert "2 pairs (--pairs);" in (a / "compare" / "compare.md").read_text()
+    with pytest.raises(SystemExit, match=r"^kage.bench compare: --pairs backgrund/1: .*A ran no plain pair of that "
+                                         r"name; did you mean background/1"):
+        compare.compare([str(a), str(b)], pairs=["backgrund/1"], reps=100)
+    bench = json.loads((b / "bench.json").read_text())
+    (b / "bench.json").write_text(json.dumps({**bench, "units": ["background/1", "background/2"]}))
+    with pytest.raises(SystemExit, match=r"--pairs layout/1: .*B ran no plain pair of that name: give --pairs that "
+                                         r"every directory ran$"):
+        compare.compare([str(a), str(b)], pairs=["layout/1"], reps=100)
+
+
+def test_refuses_directories_with_no_pair_in_common(two):
+    a, b = two
+    for path, units in ((a, ["layout/1"]), (b, ["background/1", "background/2"])):
+        bench = json.loads((path / "bench.json").read_text())
+        (path / "bench.json").write_text(json.dumps({**bench, "units": units}))
+    with pytest.raises(SystemExit, match=r"the directories ran no plain pair in common \(pairs: A 1 \(layout/1\), B 2 "
+                                         r"\(background/1, background/2\)\): compare directories of one suite's pairs"):
+        compare.compare([str(a), str(b)], reps=100)
 
 
 def test_refuses_directories_with_no_result_in_common(two):
@@ -144,8 +232,8 @@ def test_refuses_directories_with_no_result_in_common(two):
         shutil.rmtree(b / "runs" / name)
     for seed in (1, 2, 3):
         (a / "runs" / "layout/1" / f"seed_{seed}" / "summary.json").unlink()
-    with pytest.raises(SystemExit, match=r"no \(pair, seed\) result is finished in every directory \(finished: A 6, B "
-                                         r"3\): run the same pairs and seeds"):
+    with pytest.raises(SystemExit, match=r"no \(pair, seed\) result of the pairs and seeds compared is finished in "
+                                         r"every directory \(finished: A 0, B 3\): run the same pairs and seeds"):
         compare.compare([str(a), str(b)], reps=100)
 
 
@@ -184,8 +272,107 @@ def test_refuses_another_protocol(two, tmp_path):
     a, _ = two
     longer = method(tmp_path / "E", {"background/1": [0.1] * 3}, args={**ARGS, "total_timesteps": 4096,
                                                                       "eval_episodes": 8})
-    with pytest.raises(SystemExit, match=r"another protocol \(total_timesteps 2048 and 4096, eval_episodes 2 and 8\)"):
+    with pytest.raises(SystemExit, match=r"another protocol \(total_timesteps 2048 and 4096, eval_episodes 2 and 8\): "
+                                         r"compare runs trained and evaluated alike \(other total_timesteps alone: "
+                                         r"compare their first N steps with --max-step N\)$"):
         compare.compare([str(a), str(longer)], reps=100)
+    with pytest.raises(SystemExit, match=r"another protocol \(eval_episodes 2 and 8\): compare runs trained and "
+                                         r"evaluated alike$"):
+        compare.compare([str(a), str(longer)], max_step=2048, reps=100)
+
+
+# ---- --max-step: every run scored on its evaluation rows up to a step ----
+
+STEPPED = {**ARGS, "run_eval_every": 1, "num_envs": 1, "num_steps": 10}  # an evaluation every 10 steps
+
+
+def stepped(path, histories, total, args=STEPPED, steps=range(0, 1000, 10)):
+    """A directory of background/1, seeds 1 and 2, trained for `total` steps: each run's eval success at `steps`
+    (0, 10, 20, ...) from `histories` {seed: [...]} (train success 1), and a summary.json whose maxima (0.99) no
+    row has, so that a value read from it shows."""
+    write_suite(path, PAIRS, seeds=[1, 2], units=["background/1"])
+    for seed, evals in histories.items():
+        rows = [full_row(step, 1.0, {"eval": e}) for step, e in zip(steps, evals)]
+        run = write_run(path, "background/1", seed, ["eval"], plain(1.0, 0.99), rows=rows)
+        run_json = json.loads((run / "run.json").read_text())
+        (run / "run.json").write_text(json.dumps({**run_json, "args": {**run_json["args"], **args,
+                                                                        "total_timesteps": total}}))
+    return path
+
+
+@pytest.fixture
+def long_and_short(tmp_path):
+    long = stepped(tmp_path / "long", {1: [0.0, 0.2, 0.5, 0.9, 0.1], 2: [0.1, 0.4, 0.3, 0.8, 0.8]}, 40)
+    short = stepped(tmp_path / "short", {1: [0.0, 0.3, 0.4], 2: [0.0, 0.1, 0.6]}, 20)
+    return long, short
+
+
+def test_max_step_scores_the_rows_up_to_it(long_and_short):
+    long, short = long_and_short
+    result = compare.compare([str(long), str(short)], max_step=20, reps=500)
+    assert result["protocol"]["max_step"] == 20 and result["protocol"]["total_timesteps"] is None
+    assert "at or before step 20" in result["protocol"]["level_1_runs"]
+    assert [m["total_timesteps"] for m in result["methods"]] == [40, 20]
+    estimates = {m["name"]: {r["name"]: r for r in m["estimates"]["rows"]} for m in result["methods"]}
+    # long's maxima over steps 0, 10, 20: seed 1 0.5, seed 2 0.4 (not 0.9 and 0.8 after step 20, nor summary's
+    # 0.99); short's 0.4 and 0.6. Two runs: the IQM is their mean.
+    assert estimates["long"]["all pairs"]["eval_iqm"]["point"] == pytest.approx(0.45)
+    assert estimates["short"]["all pairs"]["eval_iqm"]["point"] == pytest.approx(0.5)
+    # long 0.5 beats 0.4 and loses to 0.6 (1); 0.4 ties 0.4 and loses to 0.6 (0.5): 1.5 / 4
+    p = {(r["name"], r["x"], r["y"]): r for r in result["improvement"]}
+    assert p[("all pairs", "long", "short")]["p"]["point"] == pytest.approx(1.5 / 4)
+    md = (long / "compare" / "compare.md").read_text()
+    assert "every run scored up to step 20 (--max-step; trained for long 40, short 20 steps)" in md
+    final = compare.compare([str(long), str(short)], max_step=20, protocol="final", reps=500)
+    estimates = {m["name"]: {r["name"]: r for r in m["estimates"]["rows"]} for m in final["methods"]}
+    # the rows at step 20: long 0.5 and 0.3, short 0.4 and 0.6
+    assert estimates["long"]["all pairs"]["eval_iqm"]["point"] == pytest.approx(0.4)
+    assert estimates["short"]["all pairs"]["eval_iqm"]["point"] == pytest.approx(0.5)
+    # the long one against itself up to step 35 (its rows at 0, 10, 20, 30): maxima 0.9 and 0.8 -> 0.85
+    again = compare.compare([str(long), str(long)], names=["x", "y"], out_dir=str(long / "again"), max_step=35,
+                            reps=500)
+    assert again["methods"][0]["estimates"]["rows"][-1]["eval_iqm"]["point"] == pytest.approx(0.85)
+
+
+def test_max_step_names_other_last_evaluations(long_and_short, tmp_path):
+    """A run of 25 steps in iterations of 5, evaluated every 10 steps, evaluates at 0, 10, 20 and at its end, 25;
+    up to step 25 the 40-step runs' last evaluation is at 20: compare.md says so."""
+    long, _ = long_and_short
+    odd = stepped(tmp_path / "odd", {1: [0.0, 0.1, 0.2, 0.7], 2: [0.0, 0.1, 0.2, 0.3]}, 25,
+                  {**STEPPED, "run_eval_every": 2, "num_steps": 5}, (0, 10, 20, 25))
+    result = compare.compare([str(long), str(odd)], max_step=25, reps=500)
+    assert [m["last_evaluation_steps"] for m in result["methods"]] == [[20], [25]]
+    estimates = {m["name"]: m["estimates"]["rows"][-1]["eval_iqm"]["point"] for m in result["methods"]}
+    assert estimates == {"long": pytest.approx(0.45), "odd": pytest.approx(0.5)}  # (0.7 + 0.3) / 2
+    assert ("their last evaluations scored are at step 20 (long), 25 (odd): a multiple of 10 steps scores the same "
+            "evaluation points") in (long / "compare" / "compare.md").read_text()
+    assert compare.compare([str(long), str(odd)], max_step=20, reps=100)["methods"][1]["last_evaluation_steps"] == [20]
+
+
+def test_max_step_refusals(long_and_short):
+    long, short = long_and_short
+    with pytest.raises(SystemExit, match=r"another protocol \(total_timesteps 40 and 20\): compare their first N steps "
+                                         r"with --max-step N \(at most 20\)$"):
+        compare.compare([str(long), str(short)], reps=100)
+    with pytest.raises(SystemExit, match=r"^kage.bench compare: --max-step 25 is beyond the 20 steps that the runs of "
+                                         r".*short trained for: give at most --max-step 20$"):
+        compare.compare([str(long), str(short)], max_step=25, reps=100)
+    with pytest.raises(SystemExit, match=r"^kage.bench compare: --max-step 5 is before the first evaluation after step "
+                                         r"0 of the runs of .*long \(step 10\): give at least --max-step 10$"):
+        compare.compare([str(long), str(short)], max_step=5, reps=100)
+    with pytest.raises(SystemExit, match=r"--max-step takes a number of steps above 0, not 0"):
+        compare.compare([str(long), str(short)], max_step=0, reps=100)
+    # a log that stops at step 10 though its run trained for 40 steps
+    log = long / "runs" / "background/1" / "seed_2" / "metrics.jsonl"
+    log.write_text("".join(line + "\n" for line in log.read_text().splitlines()[:3]))  # the train row, steps 0, 10
+    with pytest.raises(SystemExit, match=r"seed_2/metrics.jsonl has no evaluation row after step 10 and at or before "
+                                         r"step 20, which --max-step 20 reads \(its last is at step 10\): the log is "
+                                         r"incomplete"):
+        compare.compare([str(long), str(short)], max_step=20, reps=100)
+    for run_json in short.glob("runs/*/*/seed_*/run.json"):
+        run_json.unlink()
+    with pytest.raises(SystemExit, match=r"the runs of .*short have no run.json with their arguments"):
+        compare.compare([str(long), str(short)], max_step=20, reps=100)
 
 
 def test_refuses_one_directory_and_alike_names(two, tmp_path):

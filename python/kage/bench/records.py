@@ -4,9 +4,42 @@ reader (run, status, report, compare), each of which refuses a damaged record in
 
 A unit's runs are folders DIR/runs/<unit>/seed_<s>/, so a unit name must stay inside DIR/runs/ (unit_name_problem)
 and a seed be one that kage.ppo.train takes (0 <= s < 2**63)."""
-from typing import Optional, Sequence
+import re
+from typing import List, Optional, Sequence
 
 MAX_SEED = 2**63  # kage.ppo.train's --seed is below it
+MAX_SEEDS = 1_000_000  # a list of seeds beyond this is a typo (1-10000000000), not a benchmark
+
+
+def parse_seeds(text: str) -> List[int]:
+    """"1-10", "1,3,5" or "7": at most MAX_SEEDS seeds, each below 2**63 (kage.ppo.train's --seed)."""
+    seeds: List[int] = []
+    for part in text.split(","):
+        m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
+        if not m:
+            raise SystemExit(f"kage.bench: --seeds {text!r}: use a range like 1-10, a list like 1,3,5, or one seed")
+        first, last = int(m[1]), int(m[2] or m[1])
+        if last < first:
+            raise SystemExit(f"kage.bench: --seeds {text!r}: the range {first}-{last} is empty")
+        if last >= MAX_SEED:
+            raise SystemExit(f"kage.bench: --seeds {text!r}: seed {last} is too large: seeds are below 2**63")
+        if len(seeds) + last - first + 1 > MAX_SEEDS:
+            raise SystemExit(f"kage.bench: --seeds {text!r:.80}: more than {MAX_SEEDS:,} seeds, a run each per pair: "
+                             "give fewer seeds")
+        seeds.extend(range(first, last + 1))
+    return sorted(set(seeds))
+
+
+def seeds_text(seeds: Sequence[int]) -> str:
+    """parse_seeds' syntax for sorted `seeds`: [1, 2, 3, 5] -> "1-3,5"."""
+    parts: List[str] = []
+    for seed in seeds:
+        if parts and seed == last + 1:
+            parts[-1] = f"{parts[-1].split('-')[0]}-{seed}"
+        else:
+            parts.append(str(seed))
+        last = seed
+    return ",".join(parts)
 
 
 def unit_name_problem(name) -> Optional[str]:

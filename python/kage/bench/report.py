@@ -304,26 +304,29 @@ def flat_row(row: dict) -> Dict[str, Optional[float]]:
     return {k: (float(v) if is_number(v) else None) for k, v in flat.items()}
 
 
-def run_values(run: Run, protocol: str, partial: bool = False) -> Optional[Dict[str, Optional[float]]]:
+def run_values(run: Run, protocol: str, partial: bool = False,
+               max_step: Optional[float] = None) -> Optional[Dict[str, Optional[float]]]:
     """A run's value per summary key under `protocol`: "max", summary.json's maxima (over the rows logged so far
     for an unfinished run); "final", its last evaluation row. None for a run that is not in the tables: an
-    unfinished one, unless `partial` and it has an evaluation row."""
+    unfinished one, unless `partial` and it has an evaluation row. With `max_step` (kage.bench compare), only the
+    evaluation rows at or before that step count: their maxima, or the last of them."""
     if run.stats is None and not (partial and run.evaluations):
         return None
-    if protocol == "max" and run.stats is not None:
+    rows = [r for r in run.evaluations if max_step is None or r["global_step"] <= max_step]
+    if protocol == "max" and run.stats is not None and max_step is None:
         return {k: (None if v is None else float(v["max"])) for k, v in run.stats.items()}
     if protocol == "max":
         series: Dict[str, List[float]] = {}
-        for row in run.evaluations:
+        for row in rows:
             for key, value in flat_row(row).items():
                 series.setdefault(key, [])
                 if value is not None:
                     series[key].append(value)
         return {key: (max(values) if values else None) for key, values in series.items()}
-    if not run.evaluations:
+    if not rows:
         fail(f"{os.path.join(run.path, 'metrics.jsonl')} has no evaluation row, which --protocol final reads: use "
              "--protocol max, or delete the run directory and rerun `python3 -m kage.bench run`")
-    return flat_row(run.evaluations[-1])
+    return flat_row(rows[-1])
 
 
 def value_of(values: dict, key: str, where: str) -> Optional[float]:
@@ -380,13 +383,15 @@ def sweep_order(names: List[str]) -> List[str]:
 
 
 def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "max", partial: bool = False,
-              keep: Optional[Set[Tuple[str, int]]] = None) -> dict:
+              keep: Optional[Set[Tuple[str, int]]] = None, max_step: Optional[float] = None) -> dict:
     """The three levels: {"runs": level 1, "pairs": level 2 (plain pairs), "axes": level 3, "sweeps": level 2
     per sweep}; `protocol` and `partial` choose the runs and their values (run_values), and `keep`, where
-    given, the (pair, seed) results that enter (kage.bench compare: those of every method)."""
+    given, the (pair, seed) results that enter (kage.bench compare: those of every method), scored on their rows
+    up to `max_step` where given (run_values)."""
     level1, pairs, sweeps = [], [], []
     for unit in units:
-        scored = [(r, v) for r in runs[unit.name] for v in [run_values(r, protocol, partial)] if v is not None]
+        scored = [(r, v) for r in runs[unit.name] for v in [run_values(r, protocol, partial, max_step)]
+                  if v is not None]
         if keep is not None:
             scored = [(r, v) for r, v in scored if any((p["pair"], r.seed) in keep for p in unit.pairs)]
         included = [r for r, _ in scored]
@@ -396,7 +401,7 @@ def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "ma
             per_run = []
             kept = [(r, v) for r, v in scored if keep is None or (pair["pair"], r.seed) in keep]
             for run, run_value in kept:
-                from_summary = protocol == "max" and run.stats is not None
+                from_summary = protocol == "max" and run.stats is not None and max_step is None
                 where = os.path.join(run.path, "summary.json" if from_summary else "metrics.jsonl")
                 values = run_scores(run_value, label, where)
                 level1.append({"pair": pair["pair"], "unit": unit.name, "seed": run.seed, "label": label,

@@ -31,7 +31,6 @@ import argparse
 import dataclasses
 import json
 import os
-import re
 import signal
 import subprocess
 import sys
@@ -41,35 +40,13 @@ from typing import Dict, List, Optional
 from kage import front_end, resources
 from kage.ppo import plugins
 from kage.bench import gpus, run_state, tasks
-from kage.bench.records import MAX_SEED, bench_problem, suite_problem, unit_name_problem
+from kage.bench.records import bench_problem, parse_seeds, suite_problem, unit_name_problem
 from kage.bench.units import Unit, select, train_stem, training_configs, units_of
 from kage.errors import ConfigError
 from kage.util.files import (LOG_LIMIT, atomic_write, open_regular, os_error_text, read_json_record, read_regular,
                              remove_strays, write_json)
 from kage.util.lock import DirectoryLock, LockHeld
 from kage.util.stop import child_environment, die_with_parent, stop_children
-
-
-MAX_SEEDS = 1_000_000  # a list of seeds beyond this is a typo (1-10000000000), not a benchmark
-
-
-def parse_seeds(text: str) -> List[int]:
-    """"1-10", "1,3,5" or "7": at most MAX_SEEDS seeds, each below 2**63 (kage.ppo.train's --seed)."""
-    seeds: List[int] = []
-    for part in text.split(","):
-        m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
-        if not m:
-            raise SystemExit(f"kage.bench: --seeds {text!r}: use a range like 1-10, a list like 1,3,5, or one seed")
-        first, last = int(m[1]), int(m[2] or m[1])
-        if last < first:
-            raise SystemExit(f"kage.bench: --seeds {text!r}: the range {first}-{last} is empty")
-        if last >= MAX_SEED:
-            raise SystemExit(f"kage.bench: --seeds {text!r}: seed {last} is too large: seeds are below 2**63")
-        if len(seeds) + last - first + 1 > MAX_SEEDS:
-            raise SystemExit(f"kage.bench: --seeds {text!r:.80}: more than {MAX_SEEDS:,} seeds, a run each per pair: "
-                             "give fewer seeds")
-        seeds.extend(range(first, last + 1))
-    return sorted(set(seeds))
 
 
 # The trainer flags kage.bench sets for each run (the trainer's parser takes no abbreviations of them).
