@@ -101,6 +101,13 @@ def compare(label, ours, original):
     return problems
 
 
+def config_paths(side) -> list:
+    """The configs of a pair's side: one path, or a mixture's list of paths and {config, weight} items."""
+    if isinstance(side, str):
+        return [side]
+    return [item if isinstance(item, str) else item["config"] for item in side]
+
+
 def main():
     problems = compare("default", load_ours(os.path.join(REPO, "configs/default.yaml")),
                        load_original(os.path.join(HERE, "original/default_config.yaml")))
@@ -124,9 +131,9 @@ def main():
     for name in sorted(os.listdir(os.path.join(REPO, "suites"))):
         with open(os.path.join(REPO, "suites", name)) as f:
             suite = yaml.safe_load(f)
-        configs = [p[s] for p in suite.get("pairs", []) for s in ("train", "eval")]
+        configs = [c for p in suite.get("pairs", []) for s in ("train", "eval") for c in config_paths(p[s])]
         for sweep in suite.get("sweeps", []):
-            configs += [sweep["train"]] + [e["config"] for e in sweep["evals"]]
+            configs += config_paths(sweep["train"]) + [e["config"] for e in sweep["evals"]]
         for config in configs:
             flat = load_ours(os.path.join(REPO, "suites", config))
             if len(flat) < 93:
