@@ -334,6 +334,20 @@ def test_max_step_scores_the_rows_up_to_it(long_and_short):
     assert again["methods"][0]["estimates"]["rows"][-1]["eval_iqm"]["point"] == pytest.approx(0.85)
 
 
+def test_max_step_counts_an_unfinished_run_logged_past_it(long_and_short):
+    """A run still training (no summary.json) enters under --max-step N once its log is past N: its rows up to N
+    are all written. One whose log stops short of N stays out, as without --max-step."""
+    long, short = long_and_short
+    (long / "runs" / "background/1" / "seed_1" / "summary.json").unlink()  # logged to step 40, unfinished
+    result = compare.compare([str(long), str(short)], max_step=20, reps=500)
+    estimates = {m["name"]: m["estimates"]["rows"][-1]["eval_iqm"]["point"] for m in result["methods"]}
+    assert estimates == {"long": pytest.approx(0.45), "short": pytest.approx(0.5)}  # as when both had finished
+    log = long / "runs" / "background/1" / "seed_1" / "metrics.jsonl"
+    log.write_text("".join(line + "\n" for line in log.read_text().splitlines()[:3]))  # the train row, steps 0, 10
+    result = compare.compare([str(long), str(short)], max_step=20, reps=500)
+    assert result["results_compared"] == 1  # seed 2 alone: seed 1 of long has not reached step 20
+
+
 def test_max_step_names_other_last_evaluations(long_and_short, tmp_path):
     """A run of 25 steps in iterations of 5, evaluated every 10 steps, evaluates at 0, 10, 20 and at its end, 25;
     up to step 25 the 40-step runs' last evaluation is at 20: compare.md says so."""

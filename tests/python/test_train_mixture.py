@@ -44,6 +44,20 @@ def test_a_mixture_run_records_its_configs_and_evaluates_its_mixture(tmp_path):
     assert all(set(r["evals"]) == {"near_goal.yaml"} for r in evaluations)
 
 
+def test_a_mixture_of_one_config_twice_trains_as_that_config(tmp_path):
+    """Halves of one batch running one config get the seeds a batch of that config gives them, so the run's
+    rollouts, updates and evaluations are those of the config alone: the log is the same, row for row."""
+    alone = train.Args(**FLAGS, train_config_path=NEAR_GOAL, eval_config_path=RED, seed=4, out=str(tmp_path / "a"))
+    twice = dataclasses.replace(alone, train_config_path="", train_config_paths=[NEAR_GOAL, NEAR_GOAL],
+                                out=str(tmp_path / "b"))
+    train.train([alone])
+    train.train([twice])
+    ra, rb = rows(tmp_path / "a"), rows(tmp_path / "b")
+    assert [(r["kind"], r["iteration"]) for r in ra] == [(r["kind"], r["iteration"]) for r in rb]
+    for x, y in zip(ra, rb):
+        compare_values(x, y, f"{x['kind']}:{x['iteration']}")
+
+
 def test_a_pack_of_two_mixture_runs_equals_them_alone(tmp_path):
     runs = [dict(train_config_paths=[NEAR_GOAL, RED], train_weights=[3, 1], eval_config_path=RED, seed=3),
             dict(train_config_paths=[RED, NOISY], eval_config_path=NEAR_GOAL, seed=8)]

@@ -87,7 +87,14 @@ def schedule_of(run: report.Run) -> dict:
             "eval_greedy": args.get("eval_greedy")}
 
 
-def load(bench_dir: str, name: str, protocol: str) -> Method:
+def scored(run: report.Run, max_step: Optional[int]) -> bool:
+    """Whether a run enters the comparison: finished, or, under --max-step, logged past that step (every evaluation
+    at or before it is then written, and none later is read)."""
+    return run.stats is not None or (max_step is not None and bool(run.evaluations) and
+                                     run.evaluations[-1]["global_step"] >= max_step)
+
+
+def load(bench_dir: str, name: str, protocol: str, max_step: Optional[int] = None) -> Method:
     try:
         suite, bench, units, runs = report.read_benchmark(bench_dir)
     except SystemExit as e:  # the report's refusal of a directory or a record, in compare's name
@@ -101,15 +108,18 @@ def load(bench_dir: str, name: str, protocol: str) -> Method:
         fail(f"the runs of {bench_dir} were trained with different schedules ({' and '.join(sorted(schedules))}): "
              "rerun them with one set of flags")
     seeds = bench.get("seeds") or sorted({r.seed for r in every_run})
-    levels = report.aggregate(units, runs, protocol)
+    levels = report.aggregate(units, runs, protocol, partial=max_step is not None, max_step=max_step)
+    counted = {r.path for r in every_run if scored(r, max_step)}
+    levels["runs"] = [r for r in levels["runs"] if r["path"] in counted]
     if not levels["pairs"]:
         fail(f"{bench_dir} has no plain pair (only sweeps): compare reads plain pairs")
     if not levels["runs"]:
         unfinished = len(every_run)
         fail(f"{bench_dir} has no finished run (a run directory with summary.json)"
+             + (f" and none logged past step {max_step}" if max_step is not None else "")
              + (f"; its {unfinished} runs are still training or stopped" if unfinished else "") +
-             f": compare reads finished runs only: let them finish (kage.bench status {bench_dir}), or compare "
-             "other directories")
+             f": compare reads finished runs only (and, under --max-step, runs logged past it): let them finish "
+             f"(kage.bench status {bench_dir}), or compare other directories")
     ran = {p["pair"] for u in units if not u.is_sweep for p in u.pairs}
     return Method(name, bench_dir, suite, sorted(seeds), json.loads(schedules.pop()) if schedules else {}, units,
                   runs, {(r["pair"], r["seed"]) for r in levels["runs"]},
@@ -256,7 +266,8 @@ def restrict(methods: List[Method], pairs: List[str], seeds: List[int], protocol
         if max_step is not None:
             check_rows(m, common, max_step)
         m.left_out = sorted(m.results - common)
-        m.levels = report.aggregate(m.units, m.runs, protocol, keep=common, max_step=max_step)
+        m.levels = report.aggregate(m.units, m.runs, protocol, partial=max_step is not None, keep=common,
+                                    max_step=max_step)
         m.levels["pairs"] = [p for p in m.levels["pairs"] if p["pair"] in compared]  # rows of the pairs compared
         m.levels["axes"] = report.axes_of(m.levels["pairs"])
         m.estimates = intervals.interval_report(m.levels["runs"], m.levels["pairs"], reps, metric)
@@ -424,7 +435,7 @@ def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optiona
         fail(intervals.reps_problem(reps))
     if max_step is not None and (not isinstance(max_step, int) or isinstance(max_step, bool) or max_step <= 0):
         fail(f"--max-step takes a number of steps above 0, not {max_step!r}")
-    methods = [load(d, name, protocol) for d, name in zip(dirs, method_names(dirs, names))]
+    methods = [load(d, name, protocol, max_step) for d, name in zip(dirs, method_names(dirs, names))]
     chosen_seeds = choose_seeds(methods, seeds)
     chosen_pairs = choose_pairs(methods, pairs)
     check_pairs(methods, chosen_pairs)

@@ -70,7 +70,9 @@ def distinct_configs(stages: Sequence[Stage]) -> List[str]:
     """Every config the stages train on, once each, in order of first appearance."""
     seen: List[str] = []
     for stage in stages:
-        seen += [c for c in stage.configs if c not in seen]
+        for config in stage.configs:
+            if config not in seen:
+                seen.append(config)
     return seen
 
 
