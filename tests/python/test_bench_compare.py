@@ -244,7 +244,8 @@ def test_a_directory_without_finished_runs_is_named(two, tmp_path):
     empty = tmp_path / "empty"
     write_suite(empty, PAIRS)
     with pytest.raises(SystemExit, match=r"^kage.bench compare: .*empty has no finished run \(a run directory with "
-                                         r"summary.json\): compare reads finished runs only: let them finish "
+                                         r"summary.json\): compare reads finished runs only \(and, under --max-step, runs "
+                                         r"logged past it\): let them finish "
                                          r"\(kage.bench status .*empty\)"):
         compare.compare([str(a), str(empty)], reps=100)
     for summary in b.glob("runs/*/*/seed_*/summary.json"):

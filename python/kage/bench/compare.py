@@ -234,7 +234,7 @@ def check_rows(m: Method, keep: Set[Tuple[str, int]], max_step: int) -> None:
     last: Set[int] = set()
     for unit in m.units:
         for run in m.runs[unit.name]:
-            if run.stats is None or not any((p["pair"], run.seed) in keep for p in unit.pairs):
+            if not scored(run, max_step) or not any((p["pair"], run.seed) in keep for p in unit.pairs):
                 continue
             steps = [r["global_step"] for r in run.evaluations if r["global_step"] <= max_step]
             if not steps or steps[-1] <= after:
@@ -361,8 +361,9 @@ def trains_text(m: Method) -> str:
 def markdown(methods: List[Method], rows: List[dict], result: dict) -> str:
     metric = methods[0].estimates["metric"]
     protocol = result["protocol"]
-    listed = "; ".join(f"**{m.name}**: `{m.bench_dir}`, {len(m.results)} finished (pair, seed) results"
-                       for m in methods)
+    done = "finished (pair, seed) results" if protocol["max_step"] is None else \
+        f"(pair, seed) results finished or logged past step {protocol['max_step']}"
+    listed = "; ".join(f"**{m.name}**: `{m.bench_dir}`, {len(m.results)} {done}" for m in methods)
     left_out = [left_out_text(m) for m in methods if m.left_out]
     pairs_out = [pairs_text(m) for m in methods if m.pairs_left_out]
     chosen = result["pairs_chosen"]
