@@ -113,7 +113,7 @@ class JaxEnv:
         bit 1 right, bit 2 jump). A value outside 0..7 is recorded in the state (``check`` raises it) and
         the step runs with its low 3 bits, as the runtime masks any action (spec 3.2)."""
         self._check_state(state)
-        actions = self._check_actions(actions)
+        actions = checked_actions(actions, self.num_envs)
         s = self._state
         finals = [state.final_info[name] for name in _INFO_NAMES]
         outs = _ffi.step_call([s.latent, s.segments, s.visual, s.final_obs, *self._outputs, s.latent, s.segments,
@@ -165,18 +165,6 @@ class JaxEnv:
                 if g.dtype != w.dtype:
                     raise TypeError(f"state.{name}: dtype {g.dtype}, expected {w.dtype}")
 
-    def _check_actions(self, actions):
-        shape, dtype = getattr(actions, "shape", None), getattr(actions, "dtype", None)
-        if shape is None or dtype is None:
-            actions = _host_actions(actions, self.num_envs)
-            shape, dtype = actions.shape, actions.dtype
-        if tuple(shape) != (self.num_envs,):
-            raise ValueError(f"actions: shape {tuple(shape)}, expected ({self.num_envs},): one action per environment")
-        if dtype != jnp.int32:
-            raise TypeError(f"actions: dtype {dtype}, expected int32 (e.g. jax.random.categorical's output, or "
-                            "actions.astype(jnp.int32))")
-        return jnp.asarray(actions)
-
     def _batch_fields(self) -> Dict[str, Any]:
         """The batch's fields (kage.fields.BATCH_FIELDS), constants of the graph: one config, index 0."""
         return {"config": jnp.zeros((self.num_envs,), jnp.int32)}
@@ -227,6 +215,21 @@ def check_action_record(action_error) -> None:
     raise ValueError(f"kage.jax: the actions of step {step} held {value} for environment {where[-1]}{batch}"
                      f"{more}: {vector.native().action_range_text()}; that step ran with the value masked to "
                      "its low 3 bits")
+
+
+def checked_actions(actions, num_envs: int):
+    """`actions` as one int32 JAX array of shape [num_envs] (host values converted first), or ValueError or
+    TypeError naming `actions`: what a JaxEnv's and a JaxMixture's step take."""
+    shape, dtype = getattr(actions, "shape", None), getattr(actions, "dtype", None)
+    if shape is None or dtype is None:
+        actions = _host_actions(actions, num_envs)
+        shape, dtype = actions.shape, actions.dtype
+    if tuple(shape) != (num_envs,):
+        raise ValueError(f"actions: shape {tuple(shape)}, expected ({num_envs},): one action per environment")
+    if dtype != jnp.int32:
+        raise TypeError(f"actions: dtype {dtype}, expected int32 (e.g. jax.random.categorical's output, or "
+                        "actions.astype(jnp.int32))")
+    return jnp.asarray(actions)
 
 
 def _host_actions(actions, num_envs: int):

@@ -16,7 +16,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from kage import front_end, mixture, resources, vector
-from kage.jax.env import JaxEnv, KageState, _host_actions, check_action_record, make_config_env, seed_words
+from kage.jax.env import JaxEnv, KageState, check_action_record, checked_actions, make_config_env, seed_words
 
 _FINAL_KEYS = ("_final", "_final_obs", "_final_info")
 
@@ -66,7 +66,7 @@ class JaxMixture:
         """One step of every environment with ``actions``, int32 [num_envs]: each config's slice goes to its part
         (values outside 0..7 are recorded as JaxEnv records them)."""
         self._check_state(state)
-        actions = self._actions(actions)
+        actions = checked_actions(actions, self.num_envs)
         results = [part.step(s, actions[sl]) for part, s, sl in zip(self.parts, state.parts, self._slices)]
         new = MixtureState(tuple(r[0] for r in results), self.spec_hash)
         obs, reward, terminated, truncated = (self._joined([r[i] for r in results]) for i in range(1, 5))
@@ -83,19 +83,6 @@ class JaxMixture:
     def __repr__(self) -> str:
         return (f"<kage.jax.JaxMixture of {len(self.configs)} configs {list(self.counts)}, {self.num_envs} envs, "
                 f"spec {self.spec_hash[:12]}>")
-
-    def _actions(self, actions):
-        """The whole batch's actions, checked as JaxEnv checks them (shape [num_envs], int32)."""
-        shape, dtype = getattr(actions, "shape", None), getattr(actions, "dtype", None)
-        if shape is None or dtype is None:
-            actions = _host_actions(actions, self.num_envs)
-            shape, dtype = actions.shape, actions.dtype
-        if tuple(shape) != (self.num_envs,):
-            raise ValueError(f"actions: shape {tuple(shape)}, expected ({self.num_envs},): one action per environment")
-        if dtype != jnp.int32:
-            raise TypeError(f"actions: dtype {dtype}, expected int32 (e.g. jax.random.categorical's output, or "
-                            "actions.astype(jnp.int32))")
-        return jnp.asarray(actions)
 
     def _check_state(self, state, batched: bool = False) -> None:
         if not isinstance(state, MixtureState):
