@@ -380,8 +380,8 @@ def markdown(methods: List[Method], rows: List[dict], result: dict) -> str:
                   f": a multiple of {protocol['eval_every_steps']} steps scores the same evaluation points")
     differ = len({json.dumps([m.pairs[p]["train"].get("spec_sha256") for p in result["pairs"]]) for m in methods}) > 1
     trains = "; ".join(trains_text(m) for m in methods) + (
-        ". The methods train differently, so each one's train success is measured on its own training (a "
-        "mixture's first config); the eval side is the same configs for all" if differ else "")
+        ". The methods train differently, so each one's train success is measured on its own training (for a "
+        "mixture, on the mixture); the eval side is the same configs for all" if differ else "")
     return (f"# {methods[0].suite.get('suite', 'suite')}: {' vs '.join(m.name for m in methods)}\n\n"
             f"Methods: {listed}. Seeds {seeds_text(methods[0].seeds)}{' (--seeds)' if result['seeds_chosen'] else ''}; "
             f"{pairs}; the same eval configs and protocol ({schedule}{steps}). Trains on: {trains}. "

@@ -37,7 +37,8 @@ def score_suite(agent, spec: dict, file: str, state: dict, options) -> dict:
     units = select(units_of(suite), options.pairs, "kage.bench score")
     runs = {}
     for index, unit in enumerate(units, start=1):
-        # A mixture's or schedule's "train" is its first config, as in kage.ppo.train's own evaluations.
+        # A mixture's or schedule's "train" side is scored on its first config here (one config's batch), where
+        # kage.ppo.train's own evaluations run the stage's mixture.
         configs = [("train", unit.train_configs[0])] + list(zip(unit.eval_labels, unit.evals))
         envs = {label: open_env(path, options.num_envs, spec, file, options) for label, path in configs}
         row = evaluation_rows(agent, [EvalTargets(options.seed, envs)], settings_of(spec, options), state["iteration"],

@@ -42,8 +42,8 @@ class Unit:
 
     @property
     def train_configs(self) -> List[str]:
-        """The configs the unit trains on, distinct, in order of first appearance: the first is the one its
-        runs' "train" evaluation runs (kage.ppo.train)."""
+        """The configs the unit trains on, distinct, in order of first appearance (kage.ppo.train labels them
+        train, train.1, ...; its "train" evaluation runs the current stage's mixture)."""
         return training_configs(self.training)
 
     @property
