@@ -110,8 +110,8 @@ class Args:
 
 
 # The arguments that differ between the runs of a pack; the others are the pack's, shared.
-PER_RUN = ("train_config_path", "train_config_paths", "train_weights", "train_schedule", "eval_config_path", "eval_config_paths", "eval_config_labels", "seed", "out",
-           "exp_name")
+PER_RUN = ("train_config_path", "train_config_paths", "train_weights", "train_schedule", "eval_config_path",
+           "eval_config_paths", "eval_config_labels", "seed", "out", "exp_name")
 
 
 def parse_args(argv: Optional[List[str]] = None) -> Args:

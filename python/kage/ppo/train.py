@@ -124,9 +124,10 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
 
     for run in runs:
         run.env.reset(seed=kage.env_seeds(run.args.seed, N))
-    views = BatchViews(runs, device)  # views of the runtime's buffers, which every step rewrites in place
-    frames, env_reward, env_terminated, env_truncated = views.frames, views.reward, views.terminated, views.truncated
     specs = [run.env.resolved_specs[0]["config"] for run in runs]  # the hidden game's: a mixture's configs share it
+    # Views of the runtime's buffers, which every step rewrites in place.
+    views = BatchViews(runs, [spec["dist_to_success"] for spec in specs], device)
+    frames, env_reward, env_terminated, env_truncated = views.frames, views.reward, views.terminated, views.truncated
     stack = FrameStack(torch.stack(frames)) if args.use_frame_stack else None
     normalizer = RewardNormalizer((K, N), args.gamma, device) if args.normalize_reward else None
     state = LoopState.start(K, N, device)
@@ -159,8 +160,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     for iteration in range(start_iteration, last_iteration + 1):
         iteration_start = time.perf_counter()
         for k, run in enumerate(runs):  # a schedule's stage boundary: the run's batches for the new mixture
-            if schedule.stage_at(run.stages, iteration) != run.stage:
-                enter_stage(run, schedule.stage_at(run.stages, iteration), threads, reset=True)
+            stage = schedule.stage_at(run.stages, iteration)
+            if stage != run.stage:
+                enter_stage(run, stage, threads, reset=True)
                 views.bind(k, run.env)
                 state.next_done[k] = 1.0  # the episodes under way end here
                 if stack:
@@ -240,7 +242,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                         draws = plugins.augment_draws(random, AUGMENT_STREAM, counter, state.optimizer_steps)
                         augmented = plugins.augment_frames(augment, args.augment, obs, draws, images)
                 with timer("update_forward"):
-                    plain = (obs, images) if frames_in_place else (frames_at(obs, images),)
+                    # Under update the loss reads the augmented frames alone: no plain minibatch is gathered.
+                    plain = None if args.augment_mode == "update" and augmented is not None else \
+                        (obs, images) if frames_in_place else (frames_at(obs, images),)
                     loss, terms = minibatch_loss(agent, plain, augmented, b_actions[runs_axis, mb],
                                                  b_logprobs[runs_axis, mb], b_values[runs_axis, mb],
                                                  b_advantages[runs_axis, mb], b_returns[runs_axis, mb], var_returns,
@@ -292,10 +296,11 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     return runs
 
 
-def minibatch_loss(agent, plain: tuple, augmented: Optional[torch.Tensor], actions, old_logprob, old_value, advantages,
-                   returns, var_returns, args: Args, ent_coef: float):
+def minibatch_loss(agent, plain: Optional[tuple], augmented: Optional[torch.Tensor], actions, old_logprob, old_value,
+                   advantages, returns, var_returns, args: Args, ent_coef: float):
     """One minibatch's loss [K] (§2.6) as --augment-mode says, and its named terms: PPO's losses on the network's
-    outputs for the plain frames (`plain`: its arguments), or under update on the augmented ones; under drac,
+    outputs for the plain frames (`plain`: its arguments; None under update), or under update on the augmented
+    ones; under drac,
     + drac_coef (G_pi + G_V) between the plain and the augmented frames' outputs (kage.ppo.losses), G_V in units
     of var_returns [K], the variance of each run's returns over its batch."""
     inputs = (augmented,) if args.augment_mode == "update" and augmented is not None else plain
@@ -390,9 +395,9 @@ class BatchViews:
     """Device views of the outputs of each run's training batch, which every step rewrites in place: the frames,
     rewards and flags as lists over the runs, the final frames, and the finished episodes' metrics."""
 
-    def __init__(self, runs: List[Run], device):
+    def __init__(self, runs: List[Run], dists_to_success: List[float], device):
         self.device = device
-        self.dists_to_success = [run.env.resolved_specs[0]["config"]["dist_to_success"] for run in runs]
+        self.dists_to_success = dists_to_success
         self.frames, self.reward, self.terminated, self.truncated, self.final_frames, self.infos = \
             ([None] * len(runs) for _ in range(6))
         for k, run in enumerate(runs):
