@@ -8,6 +8,7 @@ from typing import Dict, List, Optional
 import torch
 
 from kage.fields import ALL, BY_NAME, DIFF_METRICS, LISTED, RECORD, RECORD_COLUMNS
+from kage.ppo import streams
 from kage.ppo.counter_random import CounterRandom
 from kage.ppo.policy import policy_step
 from kage.ppo.wrappers import FrameStack
@@ -83,6 +84,8 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
     infos = []
     for env, seed in zip(flat_envs, [s for run in seeds for s in run]):
         infos.append(env.reset(seed=seed)[1])
+    env_streams = streams.streams_of(flat_envs)  # the trainer's: a stream per run (kage.ppo.streams)
+    streams.wait_for(env_streams)
     frames = [torch.from_dlpack(env.outputs()[0]) for env in flat_envs]
     metrics = EpisodeMetrics(infos, [c["dist_to_success"] for c in specs], device)
     stack = FrameStack(torch.stack(frames)) if settings.frame_stack else None
@@ -100,6 +103,7 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
                                         bf16=settings.bf16, greedy=settings.greedy)
             for env, action in zip(flat_envs, actions.view(len(flat_envs), n)):
                 env.step(action)
+            streams.wait_for(env_streams)
             if stack:
                 stack.push(torch.stack(frames), metrics.mask())
             records.append(metrics.rows())

@@ -33,6 +33,8 @@ Packing: the loop trains K runs at once (K = 1 for a lone run; `kage.bench run -
 own parameters, optimizer state, random streams, environments and run directory, and follows the same
 algorithm as alone; tensors carry a leading run axis [K, ...], and one grouped forward and one backward
 per rollout step and per minibatch serve all K runs, so the learner's kernel launches do not grow with K.
+On the GPU each run's environments queue their work on a stream of their own (kage.ppo.streams), so the
+pack's K batches, too small each to fill the device, step at once.
 
 The environments and the learner share the device: observations, actions, rewards and episode metrics
 never leave it during a rollout or an evaluation; the host reads a few scalars once per iteration for
@@ -53,7 +55,7 @@ import kage
 from kage import front_end
 from kage.errors import ConfigError
 from kage.fields import EPISODE_METRICS as METRICS
-from kage.ppo import checkpoint, plugins, rundir, schedule, tensorboard_log, video
+from kage.ppo import checkpoint, plugins, rundir, schedule, streams, tensorboard_log, video
 from kage.ppo.agent import frames_at
 from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args, stages_of
 from kage.ppo.counter_random import CounterRandom
@@ -124,6 +126,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
 
     for run in runs:
         run.env.reset(seed=kage.env_seeds(run.args.seed, N))
+    streams.wait_for(run.stream for run in runs)
     specs = [run.env.resolved_specs[0]["config"] for run in runs]  # the hidden game's: a mixture's configs share it
     # Views of the runtime's buffers, which every step rewrites in place.
     views = BatchViews(runs, [spec["dist_to_success"] for spec in specs], device)
@@ -169,6 +172,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                     stack.restart(k, frames[k])
                 if normalizer:
                     normalizer.ret[k] = 0.0
+        streams.wait_for(run.stream for run in runs)
         if args.anneal_lr:  # §2.6
             optimizer.param_groups[0]["lr"] = args.learning_rate * (1.0 - (iteration - 1.0) / args.num_iterations)
         episode_sums = torch.zeros((K, len(METRICS) + 1), device=device)  # count, then the nine metrics
@@ -192,6 +196,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
             with timer("env"):
                 for run, a in zip(runs, action):
                     run.env.step(a)
+                streams.wait_for(run.stream for run in runs)
                 reward = torch.stack(env_reward)
                 state.next_done = (torch.stack(env_terminated) | torch.stack(env_truncated)).float()  # QUIRK (§2.5 b)
                 finished = finished_at[step] = views.episode.mask()
@@ -331,6 +336,7 @@ class Run:
     stages: List[schedule.Stage]  # what it trains on (one stage of one config, unless a mixture or schedule)
     labels: Dict[str, str]  # each training config's label, by path
     env: Optional["kage.VecEnv"] = None  # the training batch of stage `stage`
+    stream: Optional[torch.cuda.Stream] = None  # the CUDA stream of the run's batches (kage.ppo.streams)
     eval_envs: Dict[str, "kage.VecEnv"] = field(default_factory=dict)  # "train", then the eval configs by label
     stage: int = 0
     dir: Optional[rundir.RunDir] = None  # opened once everything that can be refused was checked
@@ -351,12 +357,14 @@ def open_batches(args: Args, threads: int) -> Run:
             raise SystemExit(f"kage.ppo.train: {e}") from None
         except ConfigError as e:  # kagec's located line names the key, both files and the rule
             raise SystemExit(str(e)) from None
-    run = Run(args, specs, stages, {path: label for label, path in configs[:len(schedule.distinct_configs(stages))]})
+    run = Run(args, specs, stages, {path: label for label, path in configs[:len(schedule.distinct_configs(stages))]},
+              stream=streams.new_stream(args.device))
     run.env = stage_batch(run, 0, args.num_envs, "--num-envs", threads, seed=args.seed)
     if args.run_eval_every > 0 and args.eval_episodes > 0 and args.eval_num_envs > 0:
         run.eval_envs["train"] = stage_batch(run, 0, args.eval_num_envs, "--eval-num-envs", threads)
         for label, path in configs[len(run.labels):]:
-            run.eval_envs[label] = make_batch(specs, label, path, args.eval_num_envs, "--eval-num-envs", args, threads)
+            run.eval_envs[label] = make_batch(specs, label, path, args.eval_num_envs, "--eval-num-envs", args, threads,
+                                              run.stream)
     return run
 
 
@@ -365,11 +373,11 @@ def stage_batch(run: Run, stage: int, num_envs: int, flag: str, threads: int, **
     by its weights (a mixture whenever the run trains on more than one config)."""
     configs, weights = run.stages[stage].configs, run.stages[stage].weights
     if not schedule.is_mixture(run.stages):
-        return make_batch(run.specs, "train", configs[0], num_envs, flag, run.args, threads, **seed)
+        return make_batch(run.specs, "train", configs[0], num_envs, flag, run.args, threads, run.stream, **seed)
     label = "stage " + str(stage + 1) if run.args.train_schedule else "train"
     try:
         env = kage.make_vec(list(configs), num_envs, device=run.args.device, asset_root=run.args.asset_root,
-                            threads=threads, weights=weights, **seed)
+                            threads=threads, weights=weights, stream=run.stream, **seed)
     except (ValueError, RuntimeError, OSError) as e:
         raise SystemExit(f"kage.ppo.train: the mixture of {', '.join(configs)} ({label}, {flag} {num_envs}): {e}") \
             from None
@@ -414,11 +422,12 @@ class BatchViews:
 
 
 def make_batch(specs: Dict[str, dict], label: str, path: str, num_envs: int, flag: str, args: Args, threads: int,
-               **seed) -> "kage.VecEnv":
-    """A batch of config `label` (`num_envs` environments, set by `flag`), checked to run the Spec resolved for it;
-    what make_vec refuses (too large for the memory, no GPU) ends the trainer with its message."""
+               stream: Optional[torch.cuda.Stream], **seed) -> "kage.VecEnv":
+    """A batch of config `label` (`num_envs` environments, set by `flag`) on `stream`, checked to run the Spec
+    resolved for it; what make_vec refuses (too large for the memory, no GPU) ends the trainer with its message."""
     try:
-        env = kage.make_vec(path, num_envs, device=args.device, asset_root=args.asset_root, threads=threads, **seed)
+        env = kage.make_vec(path, num_envs, device=args.device, asset_root=args.asset_root, threads=threads,
+                            stream=stream, **seed)
     except (ValueError, RuntimeError, OSError) as e:
         raise SystemExit(f"kage.ppo.train: config '{path}' ({label}, {flag} {num_envs}): {e}") from None
     rundir.check_env(specs, [label], env)
@@ -665,6 +674,7 @@ def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalize
     c = checkpoints[0]
     state.iteration, state.global_step = c["iteration"], c["global_step"]
     state.optimizer_steps, state.train_seconds = c["optimizer_steps"], c["train_seconds"]
+    streams.wait_for(run.stream for run in runs)
     for run in runs:
         print(f"kage.ppo.train: resuming {run.dir.path} after iteration {c['iteration']} (its checkpoint, log and "
               "arguments agree)", file=sys.stderr)
