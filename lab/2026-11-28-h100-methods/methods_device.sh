@@ -4,14 +4,14 @@
 # .old-ppo holds python/kage/ppo/train.py and evaluation.py of the commit before kage.ppo.streams (every batch on
 # the legacy default stream), for the trainer's speed before and after on the same machine.
 # Every call: the methods, each a runner (lab/tools/table_device.sh) of the filters and effects pairs of
-# suites/kage_bench.yaml (all train on IMAGE_SKELETON: one training per seed under --share-training, evaluated on
-# the 12 eval configs), seeds 1-5, the protocol's 25 M steps, the table's flags and one augmentation:
-#   GPU 1 drac colour jitter, GPU 2 drac random convolution, GPU 3 rollout colour jitter (call 1),
-#   GPU 0 drac overlay (started at the end of call 1, after GPU 0's measurements).
-# Call 1 also, on GPU 0: the GPU tests of the trainer on mixtures, of mixtures, resume and the rollout graph; the
-# mixture's stepping rate (lab/tools/mixture_speed.py); the trainer's at K = 16 on IMAGE_SKELETON and on a mixture of
-# four, with and without a stream per run. Calls 2 and 3 wait (LIMIT seconds); call 3 then brings home, in one
-# archive, every runner's finished tasks (pack_task.py, with checksums and provenance) and every run's log so far.
+# suites/kage_bench.yaml (all train on IMAGE_SKELETON; under --share-training two trainings per seed, one evaluated
+# on filters/1-9 and effects/1, one on effects/2-3), seeds 1-5, the protocol's 25 M steps, the table's flags and one
+# augmentation: GPU 1 drac colour jitter, GPU 2 drac random convolution, GPU 3 rollout colour jitter (started by
+# call 1), GPU 0 drac overlay (started by call 2, after GPU 0's measurements).
+# Call 1 also, on GPU 0: the GPU tests of the trainer on mixtures, of mixtures and of resume; the mixture's stepping
+# rate (lab/tools/mixture_speed.py). Call 2, on GPU 0 first: the trainer's rate at K = 16 on IMAGE_SKELETON and on a
+# mixture of four, with and without a stream per run. Calls 2 and 3 wait (LIMIT seconds). Every call brings home, in
+# one archive, every runner's finished tasks (pack_task.py, with checksums and provenance) and every run's log so far.
 set -uo pipefail
 : "${COMMIT:?COMMIT=<the commit of this tree>}" "${CALL:?CALL=1, 2 or 3}"
 OUT=${OUT:-/tmp/kage-device-out}
@@ -76,11 +76,13 @@ if [ "$CALL" = 3 ]; then
   runner drac_color_jitter "${LIMIT:-450}"
   for name in drac_random_conv rollout_color_jitter drac_overlay; do runner "$name" 20; done
   summary
-  for name in "${!GPU[@]}"; do  # every run's log so far, finished or not
-    (cd "/tmp/kage-m-$name" && tar czf "$OUT/$name/runs_so_far.tar.gz" --exclude=checkpoints --exclude=tensorboard \
-      --exclude='*.lock' bench.json suite.json runner.log runner.calls tasks.json runs tasks/*.log 2>/dev/null)
-  done
-  (cd "$OUT" && tar cf methods.tar drac_* rollout_* && rm -rf drac_* rollout_*)
 fi
-rmdir "$OUT"/drac_* "$OUT"/rollout_* 2>/dev/null
+# Every call brings home every run's log so far, finished or not: a machine given back between calls (idle over
+# its release time) takes the runs with it, as it did once between calls 2 and 3.
+for name in "${!GPU[@]}"; do
+  [ -d "/tmp/kage-m-$name" ] || continue
+  (cd "/tmp/kage-m-$name" && tar czf "$OUT/$name/runs_so_far.tar.gz" --exclude=checkpoints --exclude=tensorboard \
+    --exclude='*.lock' bench.json suite.json runner.log runner.calls tasks.json runs tasks/*.log 2>/dev/null)
+done
+(cd "$OUT" && tar cf methods.tar drac_* rollout_* && rm -rf drac_* rollout_*)
 tail -80 "$OUT/call$CALL.log"
