@@ -15,7 +15,7 @@ import json
 import os
 import sys
 
-from kage.bench import interval_tables, tables
+from kage.bench import interval_tables, tables, training_runs
 from kage.bench.report import read_evaluations
 from kage.util.tables import md_table
 
@@ -62,14 +62,11 @@ def pair_table(report: dict, paper: dict) -> str:
                      "paper's axis drop"], rows, 1)
 
 
-def training_runs(bench_dir: str, report: dict) -> list:
-    """(unit, seed, max train success, train success at the end, collapsed) per finished training run."""
-    found = []
-    for unit, seed in sorted({(r["unit"], r["seed"]) for r in report["levels"]["runs"] if r["finished"]}):
-        rows = read_evaluations(os.path.join(bench_dir, "runs", unit, f"seed_{seed}", "metrics.jsonl"))
-        success = [r["train"][SUCCESS] for r in rows]
-        found.append((unit, seed, max(success), success[-1], rows[-1]["train"]["jump_count"] == 0))
-    return found
+def finished_runs(bench_dir: str, report: dict) -> list:
+    """The outcome of each finished training run (kage.bench.training_runs), in unit and seed order."""
+    return [training_runs.outcome(unit, seed, read_evaluations(os.path.join(bench_dir, "runs", unit, f"seed_{seed}",
+                                                                            "metrics.jsonl")), SUCCESS)
+            for unit, seed in sorted({(r["unit"], r["seed"]) for r in report["levels"]["runs"] if r["finished"]})]
 
 
 def main() -> None:
@@ -81,13 +78,12 @@ def main() -> None:
     with open(paper_path) as f:
         paper = json.load(f)
     results = sum(p["n_seeds"] for p in report["levels"]["pairs"])
-    runs = training_runs(bench_dir, report)
-    collapsed = sum(c for *_, c in runs)
-    never = sum(top < 0.1 for _, _, top, _, _ in runs)
-    mean_max = sum(top for _, _, top, _, _ in runs) / len(runs)
+    runs = finished_runs(bench_dir, report)
+    counts = training_runs.summary(runs)
     low, high = paper["train_success_axis_means"]
     seeds = md_table(["training run", "seed", "train success, max", "at the end", "collapsed"],
-                     [[u, s, f"{top:.2f}", f"{end:.2f}", "yes" if c else ""] for u, s, top, end, c in runs], 1)
+                     [[o.unit, o.seed, f"{o.best:.2f}", f"{o.last:.2f}", "yes" if o.collapsed else ""] for o in runs],
+                     1)
     lines = [
         "# The whole table beside the paper",
         "",
@@ -100,9 +96,10 @@ def main() -> None:
         "## Per axis", "", axis_table(report, paper),
         "## Per pair", "", pair_table(report, paper),
         "## Train success and collapse", "",
-        f"Mean over training runs of the max train success: {mean_max:.2f} (paper's axis means: {low:.2f} to "
-        f"{high:.2f}). Never above 0.1: {never} of {len(runs)}. Collapsed to never jumping (no jump on the "
-        f"train config at the last evaluation point): {collapsed} of {len(runs)}.",
+        f"Mean over training runs of the max train success: {counts['mean_best']:.2f} (paper's axis means: "
+        f"{low:.2f} to {high:.2f}). Never above {training_runs.NEVER_LEARNED}: {counts['never_learned']} of "
+        f"{len(runs)}. Collapsed to never jumping (no jump on the train config at the last evaluation point): "
+        f"{counts['collapsed']} of {len(runs)}.",
         "", seeds]
     with open(out_path, "w") as f:
         f.write("\n".join(lines))

@@ -390,6 +390,51 @@ def test_max_step_refusals(long_and_short):
         compare.compare([str(long), str(short)], max_step=20, reps=100)
 
 
+def with_train(path, histories):
+    """background/1, seeds 1 and 2, trained for 20 steps: each run's train (success_once, jump_count) at steps 0,
+    10 and 20 from `histories` {seed: [...]}, eval success 0.1 throughout."""
+    write_suite(path, PAIRS, seeds=[1, 2], units=["background/1"])
+    for seed, history in histories.items():
+        rows = []
+        for step, (success, jumps) in zip((0, 10, 20), history):
+            row = full_row(step, success, {"eval": 0.1})
+            row["train"]["jump_count"] = jumps
+            rows.append(row)
+        run = write_run(path, "background/1", seed, ["eval"], plain(max(s for s, _ in history), 0.1), rows=rows)
+        run_json = json.loads((run / "run.json").read_text())
+        (run / "run.json").write_text(json.dumps({**run_json, "args": {**run_json["args"], **STEPPED,
+                                                                        "total_timesteps": 20}}))
+    return path
+
+
+def test_train_success_and_collapse_per_method(tmp_path):
+    """Per method, its training runs: the mean of their best train success, those never above 0.1, and those
+    with no jump on the train config at the last evaluation point scored (collapsed)."""
+    a = with_train(tmp_path / "a", {1: [(0.0, 3), (0.6, 5), (1.0, 4)],    # learned: best 1.0
+                                    2: [(0.05, 2), (0.08, 1), (0.0, 0)]})  # never above 0.1, ends collapsed
+    b = with_train(tmp_path / "b", {1: [(0.2, 1), (0.9, 2), (0.0, 0)],     # learned, then collapsed
+                                    2: [(0.0, 0), (0.3, 1), (0.7, 2)]})    # collapsed at first, then learned
+    result = compare.compare([str(a), str(b)], reps=200)
+    runs = {m["name"]: m["training_runs"] for m in result["methods"]}
+    assert {k: runs["a"][k] for k in ("runs", "never_learned", "collapsed")} == {"runs": 2, "never_learned": 1,
+                                                                                "collapsed": 1}
+    assert runs["a"]["mean_best"] == pytest.approx((1.0 + 0.08) / 2)
+    assert {k: runs["b"][k] for k in ("runs", "never_learned", "collapsed")} == {"runs": 2, "never_learned": 0,
+                                                                                "collapsed": 1}
+    assert runs["b"]["mean_best"] == pytest.approx((0.9 + 0.7) / 2)
+    assert [(r["seed"], r["best"], r["last"], r["collapsed"]) for r in runs["b"]["runs_listed"]] == [
+        (1, 0.9, 0.0, True), (2, 0.7, 0.7, False)]
+    md = (a / "compare" / "compare.md").read_text()
+    assert "| method | training runs | mean of max train success_once | never above 0.1 | collapsed |" in md
+    assert "| a | 2 | 0.54 | 1 | 1 |" in md and "| b | 2 | 0.80 | 0 | 1 |" in md
+    # Up to step 10, no run has ended collapsed yet, and a's second run's best is 0.08
+    early = compare.compare([str(a), str(b)], max_step=10, out_dir=str(tmp_path / "early"), reps=200)
+    runs = {m["name"]: m["training_runs"] for m in early["methods"]}
+    assert runs["a"]["collapsed"] == runs["b"]["collapsed"] == 0
+    assert runs["a"]["mean_best"] == pytest.approx((0.6 + 0.08) / 2) and runs["a"]["never_learned"] == 1
+    assert runs["b"]["mean_best"] == pytest.approx((0.9 + 0.3) / 2)
+
+
 def test_refuses_one_directory_and_alike_names(two, tmp_path):
     a, b = two
     with pytest.raises(SystemExit, match="give two or more benchmark directories"):

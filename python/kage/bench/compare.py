@@ -9,6 +9,8 @@ randomly shifted frames, and the agent trained on a mixture of configs), with th
 - for every two methods X and Y, the probability of improvement P(X > Y) of eval success (rliable's: per pair,
   the probability that a run of X scores above a run of Y, ties counting half, averaged over the pairs), its
   interval from resampling each method's runs within each pair, independently of the other method's;
+- per method, its training runs (kage.bench.training_runs): the mean of their best train success, how many never
+  passed 0.1 and how many ended collapsed to the never-jump policy, as the published table counts them;
 - the report's interval plot and performance profile with the methods overlaid.
 
 Success is `success_once`; --metric chooses `success` or `progress` instead (after a few thousand steps no agent
@@ -36,6 +38,7 @@ improvement.csv (P(X > Y) per axis and pair of methods), compare.json (everythin
 plots/profile_<metric>.png.
 """
 import argparse
+import dataclasses
 import difflib
 import json
 import os
@@ -43,7 +46,7 @@ import sys
 from dataclasses import dataclass, field
 from typing import Dict, List, NoReturn, Optional, Set, Tuple
 
-from kage.bench import intervals, plots, report, stats
+from kage.bench import intervals, plots, report, stats, training_runs
 from kage.bench.records import parse_seeds, seeds_text
 from kage.bench.interval_tables import explanation, fmt_drop, fmt_interval, intervals_csv
 from kage.util.files import atomic_write, output_folder
@@ -73,6 +76,7 @@ class Method:
     left_out: List[Tuple[str, int]] = field(default_factory=list)  # its results that another method lacks
     trains_on: List[dict] = field(default_factory=list)  # what it trains on for the pairs compared (trains_on)
     last_steps: List[int] = field(default_factory=list)  # under --max-step, its runs' last evaluation steps scored
+    training: List[training_runs.Outcome] = field(default_factory=list)  # the training runs behind its results
     estimates: dict = field(default_factory=dict)
 
 
@@ -271,6 +275,15 @@ def restrict(methods: List[Method], pairs: List[str], seeds: List[int], protocol
         m.levels["pairs"] = [p for p in m.levels["pairs"] if p["pair"] in compared]  # rows of the pairs compared
         m.levels["axes"] = report.axes_of(m.levels["pairs"])
         m.estimates = intervals.interval_report(m.levels["runs"], m.levels["pairs"], reps, metric)
+        m.training = training_of(m, metric, max_step)
+
+
+def training_of(m: Method, metric: str, max_step: Optional[int]) -> List[training_runs.Outcome]:
+    """The outcome of each training run (run directory) behind the method's compared results, in unit and seed
+    order, on its evaluation rows up to `max_step` where given."""
+    paths = {r["path"] for r in m.levels["runs"]}
+    return [training_runs.outcome(unit.name, run.seed, run.evaluations, metric, max_step)
+            for unit in m.units for run in sorted(m.runs[unit.name], key=lambda r: r.seed) if run.path in paths]
 
 
 def trains_on(m: Method, pairs: List[str]) -> List[dict]:
@@ -395,7 +408,21 @@ def markdown(methods: List[Method], rows: List[dict], result: dict) -> str:
             f"P(X > Y): per pair, the probability that a run of X has a higher eval {metric} than a run of Y (ties "
             "count half), averaged over the pairs both have runs of; 0.5 is no difference. Its interval resamples "
             "each method's runs within each pair, independently of the other method's.\n\n"
+            f"## Train success and collapse\n\n{md_training(methods, metric)}\n"
+            "Per training run (a run directory, however many pairs it is scored for): its maximum train "
+            f"{metric} over the evaluation points scored, and whether it ended collapsed to the never-jump policy "
+            "(no jump on its train config at the last evaluation point scored).\n\n"
             f"{explanation(methods[0].estimates)}\n")
+
+
+def md_training(methods: List[Method], metric: str) -> str:
+    rows = []
+    for m in methods:
+        counts = training_runs.summary(m.training)
+        mean = "-" if counts["mean_best"] is None else f"{counts['mean_best']:.2f}"
+        rows.append([m.name, counts["runs"], mean, counts["never_learned"], counts["collapsed"]])
+    return md_table(["method", "training runs", f"mean of max train {metric}",
+                     f"never above {training_runs.NEVER_LEARNED}", "collapsed"], rows, 1)
 
 
 def improvement_csv(rows: List[dict]) -> str:
@@ -458,7 +485,9 @@ def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optiona
                            "last_evaluation_steps": m.last_steps if max_step is not None else None,
                            "training": {p: m.pairs[p]["train"].get("spec_sha256") for p in chosen_pairs},
                            "pairs_left_out": m.pairs_left_out, "results_finished": len(m.results),
-                           "left_out": [{"pair": p, "seed": s} for p, s in m.left_out], "estimates": m.estimates}
+                           "left_out": [{"pair": p, "seed": s} for p, s in m.left_out], "estimates": m.estimates,
+                           "training_runs": {**training_runs.summary(m.training),
+                                             "runs_listed": [dataclasses.asdict(o) for o in m.training]}}
                           for m in methods],
               "improvement": rows}
     try:
