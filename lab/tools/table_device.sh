@@ -18,8 +18,9 @@
 # first call's ended) starts one again, which resumes the runs from their checkpoints. $OUT holds at most
 # MAX_FILES (the device's limit on the files a call brings back): the call's log, $OUT/call.log (the build's
 # lines, then the runner's since the last call), and as many tasks as fit; a finished task left over ends the
-# call at once and is named, for the next call. What the runner has not finished when the lease ends goes with
-# the machine. A task index names the same runs in every lease (kage.bench.tasks), and DIR must be the same path
+# call at once and is named, for the next call. Every call also brings home the unfinished runs' logs so far
+# ($OUT/runs_so_far.tar.gz, one file of MAX_FILES): what the runner has not finished when the lease ends goes with
+# the machine, but not its evaluations up to the last call. A task index names the same runs in every lease (kage.bench.tasks), and DIR must be the same path
 # in every lease, since bench.json records it. COMMIT names the tree's commit (the machine gets no .git) for the
 # packs' provenance, beside the device, the command (each call that started the runner, which trained the
 # task), the call that packed it, and when it was trained and packed. Run with carry [".deps"]:
@@ -84,6 +85,26 @@ printf '%s\n' "$new_lines" >>"$OUT/call.log"
 for log in $(printf '%s\n' "$new_lines" | grep -o 'FAILED (exit [0-9-]*); see [^ ]*' | sed 's/.*; see //' | sort -u); do
   { echo "table_device: the end of $log"; tail -25 "$log"; } >>"$OUT/call.log"  # the cause, without another call
 done
+# The unfinished runs' logs so far, so that a machine given back before the next call (idle past its release
+# time, say) takes no evaluation already logged with it: $OUT/runs_so_far.tar.gz (run directories without
+# checkpoints, TensorBoard files or summary.json; unpack it over the packs for kage.bench compare --max-step).
+bring_so_far() {
+  local list
+  list=$(mktemp)
+  (cd "$DIR" && find runs -name metrics.jsonl -printf '%h\n' | while read -r run; do
+     [ -e "$run/summary.json" ] || echo "$run"; done) >"$list"
+  [ -s "$list" ] || { rm -f "$list"; return 0; }
+  if [ "$(find "$OUT" -maxdepth 1 -type f | wc -l)" -ge "$MAX_FILES" ]; then
+    echo "table_device: no room in \$OUT for runs_so_far.tar.gz (MAX_FILES $MAX_FILES)" >>"$OUT/call.log"
+    rm -f "$list"
+    return 0
+  fi
+  tar czf "$OUT/runs_so_far.tar.gz" -C "$DIR" --exclude=checkpoints --exclude=tensorboard --exclude='*.lock' \
+    bench.json suite.json tasks.json -T "$list" &&
+    echo "table_device: $(wc -l <"$list") unfinished runs' logs in runs_so_far.tar.gz" >>"$OUT/call.log"
+  rm -f "$list"
+}
+bring_so_far
 runner_alive && echo "table_device: the runner trains on ($(date -u +%H:%M:%S) UTC); call again" >>"$OUT/call.log"
 python3 -m kage.bench status "$DIR" >>"$OUT/call.log" 2>&1
 tail -40 "$OUT/call.log"
