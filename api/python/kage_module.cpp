@@ -10,14 +10,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <iterator>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include "api/python/cuda_streams.h"
+#include "api/python/device_array.h"
 #include "api/python/front_end.h"
 #include "api/python/paths.h"
 #include "kage/kage.h"
@@ -46,104 +45,9 @@ py::str text(const std::string& s) {
   return py::reinterpret_steal<py::str>(decoded);
 }
 
-/// Each kage::DType (in its enum order) as DLPack, __array_interface__ and byte size see it.
-struct DTypeFacts {
-  DLDataType dl;
-  const char* typestr;
-  size_t bytes;
-};
-// DLPack's bool type code (kDLBool, DLPack 0.8); Debian's dlpack.h is 0.6, which lacks the name.
-constexpr auto kDLPackBool = static_cast<DLDataTypeCode>(6);
-constexpr DTypeFacts kDTypes[] = {
-    {{kDLUInt, 8, 1}, "|u1", 1},  {{kDLInt, 32, 1}, "<i4", 4}, {{kDLInt, 64, 1}, "<i8", 8},
-    {{kDLFloat, 32, 1}, "<f4", 4}, {{kDLPackBool, 8, 1}, "|b1", 1}};
-static_assert(std::size(kDTypes) == static_cast<size_t>(kage::DType::kBool) + 1, "a DType without facts");
-
-const DTypeFacts& facts(kage::DType t) { return kDTypes[static_cast<size_t>(t)]; }
-py::dtype numpy_dtype(kage::DType t) { return py::dtype(facts(t).typestr); }
-
-/// One output array of a batch on the GPU: device memory owned by the batch.
-class DeviceArray {
- public:
-  DeviceArray(std::shared_ptr<kage::Env> owner, const void* data, std::vector<int64_t> shape, kage::DType dtype)
-      : owner_(std::move(owner)), data_(data), shape_(std::move(shape)), dtype_(dtype) {}
-
-  /// A DLPack capsule of this array, ready for use on `consumer_stream` (the DLPack protocol's value:
-  /// None or 1 the legacy default stream, 2 the per-thread default stream, -1 no ordering, else a
-  /// CUstream handle).
-  py::capsule dlpack(const py::object& consumer_stream) const {
-    const int64_t s = consumer_stream.is_none() ? 1 : consumer_stream.cast<int64_t>();
-    if (s == 0) raise_value_error("__dlpack__: stream 0 is ambiguous for CUDA; pass 1 for the legacy default stream");
-    std::string error;
-    if (s != -1 && !kage::python::order_after(owner_->stream(), kage::python::protocol_stream(s), &error))
-      throw std::runtime_error(error);
-    struct Context {
-      std::shared_ptr<kage::Env> owner;
-      std::vector<int64_t> shape;
-    };
-    auto* ctx = new Context{owner_, shape_};
-    auto* t = new DLManagedTensor{};
-    t->dl_tensor.data = const_cast<void*>(data_);
-    t->dl_tensor.device = {kDLCUDA, 0};
-    t->dl_tensor.ndim = static_cast<int32_t>(ctx->shape.size());
-    t->dl_tensor.dtype = facts(dtype_).dl;
-    t->dl_tensor.shape = ctx->shape.data();
-    t->dl_tensor.strides = nullptr;
-    t->dl_tensor.byte_offset = 0;
-    t->manager_ctx = ctx;
-    // Runs without the GIL when the consumer frees its tensor: C++ objects only.
-    t->deleter = [](DLManagedTensor* self) {
-      delete static_cast<Context*>(self->manager_ctx);
-      delete self;
-    };
-    return py::capsule(t, "dltensor", [](PyObject* capsule) {
-      // A consumer renames a capsule it took ("used_dltensor") and owns it from then on.
-      if (PyCapsule_IsValid(capsule, "dltensor")) {
-        auto* t = static_cast<DLManagedTensor*>(PyCapsule_GetPointer(capsule, "dltensor"));
-        if (t && t->deleter) t->deleter(t);
-      }
-    });
-  }
-
-  py::dict cuda_array_interface() const {
-    py::dict d;
-    py::tuple shape(shape_.size());
-    for (size_t i = 0; i < shape_.size(); ++i) shape[i] = shape_[i];
-    d["shape"] = shape;
-    d["typestr"] = facts(dtype_).typestr;
-    d["data"] = py::make_tuple(reinterpret_cast<uintptr_t>(data_), false);
-    d["version"] = 3;
-    d["strides"] = py::none();
-    // Version 3: the stream the data is ready on (1: the legacy default stream).
-    const uintptr_t s = reinterpret_cast<uintptr_t>(owner_->stream());
-    d["stream"] = s == 0 ? uintptr_t{1} : s;
-    return d;
-  }
-
-  /// A host copy as a numpy array (waits for the batch's queued work).
-  py::array numpy() const {
-    py::array out(numpy_dtype(dtype_), shape_);
-    std::string error;
-    if (!kage::python::copy_to_host(out.mutable_data(), data_, static_cast<size_t>(out.nbytes()), owner_->stream(),
-                                    &error))
-      throw std::runtime_error(error);
-    return out;
-  }
-
-  py::tuple shape() const {
-    py::tuple t(shape_.size());
-    for (size_t i = 0; i < shape_.size(); ++i) t[i] = shape_[i];
-    return t;
-  }
-  py::dtype dtype() const { return numpy_dtype(dtype_); }
-  uintptr_t data_ptr() const { return reinterpret_cast<uintptr_t>(data_); }
-
- private:
-  std::shared_ptr<kage::Env> owner_;
-  const void* data_;
-  std::vector<int64_t> shape_;
-  kage::DType dtype_;
-};
+using kage::python::DeviceArray;
+using kage::python::facts;
+using kage::python::numpy_dtype;
 
 /// A batch as Python sees it: kage::Env plus the export of its outputs.
 ///
