@@ -282,8 +282,9 @@ def training_of(m: Method, metric: str, max_step: Optional[int]) -> List[trainin
     """The outcome of each training run (run directory) behind the method's compared results, in unit and seed
     order, on its evaluation rows up to `max_step` where given."""
     paths = {r["path"] for r in m.levels["runs"]}
-    return [training_runs.outcome(unit.name, run.seed, run.evaluations, metric, max_step)
-            for unit in m.units for run in sorted(m.runs[unit.name], key=lambda r: r.seed) if run.path in paths]
+    found = (training_runs.outcome(unit.name, run.seed, run.evaluations, metric, max_step)
+             for unit in m.units for run in sorted(m.runs[unit.name], key=lambda r: r.seed) if run.path in paths)
+    return [o for o in found if o is not None]  # a run scored from summary.json alone has no row to read
 
 
 def trains_on(m: Method, pairs: List[str]) -> List[dict]:

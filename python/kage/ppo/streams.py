@@ -1,8 +1,9 @@
 """Each run's environments on a CUDA stream of their own, so that the batches of a pack step at once.
 
 A run's batch is a few hundred environments (a mixture's parts fewer still): its step and render kernels are
-too small to fill the GPU and last about as long as a full one. On one stream a pack's K batches, and the parts
-of each, run one after another; on a stream per run they overlap. A batch orders itself after the learner
+too small to fill the GPU and last about as long as a full one. On one stream a pack's K batches run one after
+another; on a stream per run they overlap (a mixture's parts still run one after another on their run's
+stream). A batch orders itself after the learner
 when it takes the actions (the DLPack protocol, kage.actions); the learner orders itself after the batches
 with `wait_for` before it reads their outputs, and the rest of the loop is unchanged."""
 from typing import Iterable, List, Optional
