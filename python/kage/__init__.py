@@ -24,6 +24,7 @@ _LAZY = {
     "VecEnv": "kage.vector",
     "env_seeds": "kage.vector",
     "make_vec": "kage.vector",
+    "step_batches": "kage.vector",
     "DeviceArray": "kage._native",
     "gpu_backend_built": "kage._native",
     "__version__": "kage._version",  # written by CMake (python/CMakeLists.txt) from project(VERSION)

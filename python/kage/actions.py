@@ -66,16 +66,51 @@ def _check_shape(shape, n: int) -> None:
 
 def _step_host(handle, a: np.ndarray, n: int) -> None:
     _check_shape(a.shape, n)
+    handle.step_host(_native_integers(a))
+
+
+def _native_integers(a: np.ndarray, copy_strided: bool = False) -> np.ndarray:
     if a.dtype.kind not in "iu":
         raise ValueError(f"actions of dtype {a.dtype}, expected an integer dtype (int32 or int64): "
                          f"{native().action_range_text()}")
-    if a.dtype not in (np.int32, np.int64) or not a.flags.aligned:
+    if a.dtype not in (np.int32, np.int64) or not a.flags.aligned or (
+            copy_strided and any(s % a.dtype.itemsize for s in a.strides)):
         # A native, aligned int64 copy: the binding reads only native int32/int64 whose byte stride is a
         # multiple of the item size, so a field of a packed structured array, another byte order or a
         # misaligned buffer is copied here. int64 holds every other integer kind's values (uint64 above 2**63
         # turns negative: still refused), so the runtime's range check sees them unchanged.
         a = a.astype(np.int64)
-    handle.step_host(a)
+    return a
+
+
+def submit_rows(handles, actions) -> None:
+    """Steps handles[i] with actions[i] for every i in one call, the runtime looping over the batches (each of
+    num_envs environments): ``actions`` [len(handles), num_envs], host or GPU, as ``submit`` takes one row.
+    GPU actions are ordered for the first batch's stream; the runtime orders the others' after it."""
+    shape = (len(handles), handles[0].num_envs)
+    if isinstance(actions, np.ma.MaskedArray):
+        if np.ma.getmaskarray(actions).any():
+            raise ValueError("actions: a masked array with masked elements: fill them (actions.filled(value)) or "
+                             "pass a plain array")
+        actions = actions.data
+    if hasattr(actions, "__dlpack_device__"):
+        device_type, _ = actions.__dlpack_device__()
+        if device_type in (_DLPACK_CUDA, _DLPACK_CUDA_MANAGED):
+            _check_rows(getattr(actions, "shape", None), shape)
+            native().step_rows(handles, actions.__dlpack__(stream=handles[0].stream or 1))
+            return
+        if device_type not in (_DLPACK_CPU, _DLPACK_CUDA_HOST):
+            raise ValueError(f"actions on DLPack device type {device_type}: pass them in host or CUDA memory")
+        actions = _host_array(actions)
+    a = np.asarray(actions)
+    _check_rows(a.shape, shape)
+    native().step_rows(handles, _native_integers(a, copy_strided=True))
+
+
+def _check_rows(shape, expected) -> None:
+    if shape is None or tuple(shape) != expected:
+        raise ValueError(f"actions of shape {None if shape is None else tuple(shape)}, expected {expected}: a row of "
+                         "one action per environment for each batch")
 
 
 def _step_cuda_array_interface(handle, cai: dict, n: int) -> None:

@@ -390,3 +390,22 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
     else:
         handle = native().open(configs[0], int(num_envs), device, int(threads), asset_root or "", int(stream_handle))
     return VecEnv(handle, configs if mixture else configs[0], seed, asset_root, counts)
+
+
+def step_batches(envs: Sequence[VecEnv], actions) -> None:
+    """Steps ``envs[i]`` with ``actions[i]`` for every i, as ``envs[i].step(actions[i])`` would, in one call into
+    the runtime: for a learner that steps many batches (a pack's runs, an evaluation's configs) every step, where
+    one Python call per batch would cost more than the batches' kernels. ``actions``: [len(envs), num_envs]
+    integers, host or GPU as ``step`` takes them; the batches must have one size. Read the outputs with
+    ``outputs()``, the views ``step`` returns."""
+    envs = list(envs)
+    if not envs or not all(isinstance(env, VecEnv) for env in envs):
+        raise TypeError("step_batches: a non-empty list of kage.VecEnv (from kage.make_vec)")
+    if len({id(env) for env in envs}) != len(envs):
+        raise ValueError("step_batches: a batch appears twice: step each batch once per call")
+    with contextlib.ExitStack() as held:
+        for env in sorted(envs, key=id):  # one order for every caller: two calls on other threads never deadlock
+            held.enter_context(env._one_call())
+        _actions.submit_rows([env._live() for env in envs], actions)
+        for env in envs:  # the runtime reads device actions when its kernels run
+            env._last_actions = actions

@@ -7,6 +7,7 @@ from typing import Dict, List, Optional
 
 import torch
 
+import kage
 from kage.fields import ALL, BY_NAME, DIFF_METRICS, LISTED, RECORD, RECORD_COLUMNS
 from kage.ppo import streams
 from kage.ppo.counter_random import CounterRandom
@@ -101,8 +102,7 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
             actions, _, _ = policy_step(agent, obs.view(len(envs), configs * n, *obs.shape[2:]),
                                         noise[:, step].reshape(len(envs), configs * n, num_actions),
                                         bf16=settings.bf16, greedy=settings.greedy)
-            for env, action in zip(flat_envs, actions.view(len(flat_envs), n)):
-                env.step(action)
+            kage.step_batches(flat_envs, actions.view(len(flat_envs), n))
             streams.wait_for(env_streams)
             if stack:
                 stack.push(torch.stack(frames), metrics.mask())

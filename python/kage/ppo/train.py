@@ -193,8 +193,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                 action, logprob, value = rollout(obs[step], noise[:, step])
                 values[step], actions[step], logprobs[step] = value, action, logprob
             with timer("env"):
-                for run, a in zip(runs, action):
-                    run.env.step(a)
+                kage.step_batches([run.env for run in runs], action)
                 streams.wait_for(run.stream for run in runs)
                 reward = torch.stack(env_reward)
                 state.next_done = (torch.stack(env_terminated) | torch.stack(env_truncated)).float()  # QUIRK (§2.5 b)

@@ -1,0 +1,61 @@
+"""kage.step_batches on the GPU: batches on streams of their own (as a pack's runs are), stepped by rows of one
+device actions tensor that the default stream writes, equal each batch stepped alone with its row, byte for
+byte, across autoresets; a mixture among them."""
+import numpy as np
+import torch
+
+import kage
+from support import ROOT
+
+BENCH = ROOT / "configs/kage_bench"
+SKELETON, FILTERS_5 = str(BENCH / "bases/image_skeleton.yaml"), str(BENCH / "filters/5-eval.yaml")
+N = 64
+
+
+def batches(streams):
+    configs = [SKELETON, FILTERS_5, [SKELETON, FILTERS_5], SKELETON]
+    return [kage.make_vec(c, N, device="cuda", seed=10 + i, stream=s) for i, (c, s) in enumerate(zip(configs, streams))]
+
+
+def outputs(env) -> dict:
+    obs, reward, terminated, truncated, info = env.outputs()
+    arrays = {"obs": obs, "reward": reward, "terminated": terminated, "truncated": truncated,
+              "final_obs": info["final_obs"], "_final": info["_final"]}
+    arrays.update({f"final_info/{k}": v for k, v in info["final_info"].items()})
+    return {k: torch.from_dlpack(v).clone() for k, v in arrays.items()}
+
+
+def test_rows_on_several_streams_equal_each_batch_stepped_alone():
+    streams = [torch.cuda.Stream() for _ in range(4)]
+    together, alone = batches([s.cuda_stream for s in streams]), batches([0] * 4)
+    for env in together + alone:
+        env.reset()
+    generator = torch.Generator(device="cuda").manual_seed(3)
+    finished = 0
+    for step in range(600):  # past the 500-step truncation of every episode
+        actions = torch.randint(0, 8, (4, N), device="cuda", generator=generator)  # on the default stream
+        kage.step_batches(together, actions)
+        for env, row in zip(alone, actions):
+            env.step(row)
+        torch.cuda.synchronize()
+        if step % 50 == 0 or step >= 495:
+            for a, b in zip(together, alone):
+                oa, ob = outputs(a), outputs(b)
+                for key in oa:
+                    assert torch.equal(oa[key], ob[key]), (step, key)
+        finished += sum(int(torch.from_dlpack(env.outputs()[4]["_final"]).sum()) for env in together)
+    assert finished >= 4 * N  # every environment's episode ended at least once
+
+
+def test_int32_rows_with_a_row_stride_step_as_int64_rows():
+    a, b = batches([0] * 4), batches([0] * 4)
+    for env in a + b:
+        env.reset()
+    rows = torch.randint(0, 8, (4, N), device="cuda", generator=torch.Generator(device="cuda").manual_seed(5))
+    wide = torch.zeros((4, 2 * N), dtype=torch.int32, device="cuda")
+    wide[:, :N] = rows.to(torch.int32)
+    kage.step_batches(a, rows)
+    kage.step_batches(b, wide[:, :N])  # rows 2N apart
+    torch.cuda.synchronize()
+    for x, y in zip(a, b):
+        assert np.array_equal(x.outputs()[0].numpy(), y.outputs()[0].numpy())
