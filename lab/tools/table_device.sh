@@ -2,7 +2,8 @@
 # One device-machine call of the whole KAGE-Bench table (issue 27), or of another suite's (SUITE, SEEDS, PAIRS). The
 # runner, `kage.bench run SUITE --seeds SEEDS [--pairs PAIRS] --share-training --pack PACK` with the trainer flags
 # FLAGS (defaults: kage_bench, 1-10, every pair), trains in DIR on the machine's disk:
-# - GPUS=all (a machine of several GPUs): every task, one worker per GPU (`--gpus all`);
+# - GPUS=all (a machine of several GPUs): every task, one worker per GPU (`--gpus all`), or with TASKS=0,3 only
+#   those tasks (`--tasks`: what fits a lease, the others left for the next);
 # - TASK=I: task I alone, on one GPU.
 # The runner runs in a process session of its own (setsid), which the device machine leaves running when a
 # call returns, so it trains on through the lease's calls and the gaps between them, never stopped and resumed.
@@ -27,7 +28,7 @@
 #   COMMIT=$(git rev-parse --short HEAD) GPUS=all PACK=6 bash lab/tools/table_device.sh
 #   COMMIT=... TASK=0 PACK=6 bash lab/tools/table_device.sh
 set -uo pipefail
-if [ -n "${GPUS:-}" ]; then scope=(--gpus "$GPUS"); else scope=(--task "${TASK:?GPUS=all or TASK=I}"); fi
+if [ -n "${GPUS:-}" ]; then scope=(--gpus "$GPUS" ${TASKS:+--tasks "$TASKS"}); else scope=(--task "${TASK:?GPUS=all or TASK=I}"); fi
 : "${COMMIT:?COMMIT=<the commit of this tree>: recorded in the checksum list of each pack}"
 ROOT=${ROOT:-/tmp/kage-table-tree}
 if [ ! -e "$ROOT/.copied" ]; then
@@ -56,7 +57,7 @@ run=(python3 -m kage.bench run "$SUITE" --seeds "$SEEDS" ${PAIRS:+--pairs $PAIRS
 devices=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | sort | uniq -c |
   sed -E 's/^ *([0-9]+) (.*), ([^,]*)$/\1 x \2 (driver \3)/' | paste -sd ';' -)  # 2 x NVIDIA H200 (driver 580.159.04)
 # The exact call, its settings included: the one that started the runner is the command of what it trains.
-call="COMMIT=$COMMIT ${GPUS:+GPUS=$GPUS }${TASK:+TASK=$TASK }SUITE=$SUITE SEEDS=$SEEDS ${PAIRS:+PAIRS='$PAIRS' }PACK=$PACK"
+call="COMMIT=$COMMIT ${GPUS:+GPUS=$GPUS }${TASKS:+TASKS=$TASKS }${TASK:+TASK=$TASK }SUITE=$SUITE SEEDS=$SEEDS ${PAIRS:+PAIRS='$PAIRS' }PACK=$PACK"
 call+=" LIMIT=$LIMIT DIR=$DIR PUBLISHED=$PUBLISHED FLAGS='$FLAGS' bash lab/tools/table_device.sh"
 pack_new() { python3 lab/tools/pack_task.py "$DIR" new "$OUT" "$MAX_FILES" >>"$OUT/call.log"; }
 runner_alive() { [ -s "$DIR/runner.pid" ] && kill -0 "$(cat "$DIR/runner.pid")" 2>/dev/null; }

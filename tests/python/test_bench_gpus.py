@@ -48,6 +48,34 @@ def test_two_fake_gpus_train_three_tasks(tmp_path):
     assert "3 runs: 3 done, 0 running, 0 failed, 0 interrupted, 0 not started" in status.stdout
 
 
+def test_tasks_picks_what_the_gpus_train(tmp_path):
+    out = tmp_path / "bench"
+    args = ["run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out), *TINY_TRAINING]
+    first = bench(*args, "--gpus", "all", "--tasks", "2,0")
+    assert first.returncode == 0, first.stderr
+    assert "3 tasks, 0 finished earlier; 2 to train (of tasks 2,0) on GPUs 0,1" in first.stderr
+    assert "2 runs in" in first.stderr
+    trained = [(out / "runs" / pair / "seed_1" / "summary.json").exists() for pair in PAIRS]
+    assert trained == [True, False, True]
+    rest = bench(*args, "--gpus", "all", "--tasks", "0,1")
+    assert rest.returncode == 0 and "3 tasks, 2 finished earlier; 1 to train (of tasks 0,1)" in rest.stderr, rest.stderr
+    assert (out / "runs" / PAIRS[1] / "seed_1" / "summary.json").exists()
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--gpus", "all", "--tasks", "3"], "--tasks 3: the task table of {out} has 3 tasks, 0 to 2, each named once"),
+    (["--gpus", "all", "--tasks", "1,1"], "--tasks 1,1: the task table of {out} has 3 tasks"),
+    (["--gpus", "all", "--tasks", "one"], "--tasks one: use task indices like 0,3,4"),
+    (["--tasks", "0"], "--tasks picks the tasks that --gpus trains: add --gpus all"),
+])
+def test_tasks_is_checked(tmp_path, extra, message):
+    out = tmp_path / "bench"
+    refused = bench("run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out),
+                    *TINY_TRAINING, *extra)
+    assert refused.returncode != 0 and message.format(out=out) in refused.stderr, refused.stderr
+    assert not (out / "runs").exists()
+
+
 def test_the_device_list_is_checked(monkeypatch):
     monkeypatch.delenv("CUDA_VISIBLE_DEVICES", raising=False)
     monkeypatch.setenv(gpus.FAKE_GPUS, "3")

@@ -13,7 +13,7 @@ import subprocess
 import sys
 import threading
 import time
-from typing import List
+from typing import List, Optional
 
 from kage.bench import tasks
 from kage.util.stop import child_environment, stop_children
@@ -85,10 +85,30 @@ def eta_seconds(unit_seconds: float, waiting: List[int], running: List[tuple], w
     return max(free)
 
 
-def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
-    """Trains the unfinished tasks of `table`, one worker per device; prints each task's start and end."""
-    todo = longest_first(table, [i for i, task in enumerate(table) if not all(map(tasks.is_finished, task))])
-    print(f"kage.bench run: {len(table)} tasks, {len(table) - len(todo)} finished earlier; {len(todo)} to train on "
+def parse_tasks(text: Optional[str], count: int, out: str) -> Optional[List[int]]:
+    """--tasks '0,3,4' -> [0, 3, 4], each an index of the task table of `count` tasks (None: every task)."""
+    if text is None:
+        return None
+    try:
+        chosen = [int(part) for part in text.split(",")]
+    except ValueError:
+        raise SystemExit(f"kage.bench run: --tasks {text}: use task indices like 0,3,4 (see {out}/tasks.json)") from None
+    bad = [i for i in chosen if not 0 <= i < count]
+    if bad or len(set(chosen)) != len(chosen):
+        raise SystemExit(f"kage.bench run: --tasks {text}: the task table of {out} has {count} tasks, 0 to {count - 1}, "
+                         "each named once (see tasks.json)")
+    return chosen
+
+
+def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: Optional[List[int]] = None) -> int:
+    """Trains the unfinished tasks of `table` (or of `only`, task indices), one worker per device; prints each
+    task's start and end."""
+    chosen = range(len(table)) if only is None else only
+    unfinished = [i for i in chosen if not all(map(tasks.is_finished, table[i]))]
+    todo = longest_first(table, unfinished)
+    finished = sum(all(map(tasks.is_finished, task)) for task in table)
+    scope = "" if only is None else f" (of tasks {','.join(map(str, only))})"
+    print(f"kage.bench run: {len(table)} tasks, {finished} finished earlier; {len(todo)} to train{scope} on "
           f"GPUs {','.join(devices)}", file=sys.stderr, flush=True)
     log_dir = os.path.join(bench.out, "tasks")
     os.makedirs(log_dir, exist_ok=True)
@@ -149,6 +169,6 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str]) -> int:
         print(f"kage.bench run: task(s) {', '.join(map(str, sorted(failed)))} failed (kage.bench status "
               f"{bench.out}); rerun to resume them", file=sys.stderr)
         return 1
-    print(f"kage.bench run: {sum(map(len, table))} runs in {bench.out}; tables and plots: "
+    print(f"kage.bench run: {sum(len(table[i]) for i in chosen)} runs in {bench.out}; tables and plots: "
           f"python3 -m kage.bench report {bench.out}", file=sys.stderr)
     return 0

@@ -1,5 +1,5 @@
 """python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [--pack K] [--share-training]
-[--task I | --gpus all|0,2] [trainer flags]
+[--task I | --gpus all|0,2 [--tasks 0,3]] [trainer flags]
 
 Trains every (pair, seed) of a suite manifest with `python3 -m kage.ppo.train`, each run in its own run
 directory, one process after the other; --pack K trains K runs at once in one process (one GPU), which
@@ -469,6 +469,8 @@ def main(argv: List[str]) -> int:
     parser.add_argument("--task", type=int, help="train only task I of DIR/tasks.json (a Slurm array task)")
     parser.add_argument("--gpus", help="'all' or a list like 0,2: one worker process per GPU, each training "
                                        "tasks until none is left")
+    parser.add_argument("--tasks", help="with --gpus: only these tasks of DIR/tasks.json, a list like 0,3,4 (what "
+                                        "fits a lease)")
     args, trainer_args = parser.parse_known_args(argv)
     die_with_parent()  # a --task worker of --gpus stops with its runner
     try:
@@ -481,6 +483,9 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
     """main() without its handling of file-system errors."""
     if args.task is not None and args.gpus:
         raise SystemExit("kage.bench run: --task and --gpus exclude each other: --gpus runs the tasks itself")
+    if args.tasks is not None and not args.gpus:
+        raise SystemExit("kage.bench run: --tasks picks the tasks that --gpus trains: add --gpus all (or use --task I "
+                         "for one task in this process)")
     bench = plan(args, trainer_args)
     if bench.device == "cuda":
         import torch  # here: kage.bench slurm plans on machines without torch's GPU build
@@ -500,7 +505,7 @@ def run_locked(bench: Bench, args: argparse.Namespace, devices: Optional[List[st
     table = bench.table()
     signal.signal(signal.SIGTERM, raise_stop)
     if devices:
-        return gpus.run_on_gpus(bench, table, devices)
+        return gpus.run_on_gpus(bench, table, devices, gpus.parse_tasks(args.tasks, len(table), bench.out))
     if args.task is None:
         status = train_jobs(bench, [job for task in table for job in task], "pack_", None)
     elif not 0 <= args.task < len(table):
