@@ -43,18 +43,24 @@ def unpack(packs: str, archive_name: str, dest: str) -> int:
     return len(files)
 
 
-def main() -> None:
-    if len(sys.argv) != 3:
-        sys.exit(__doc__.splitlines()[-1])
-    packs, dest = sys.argv[1:]
+def unpack_all(packs: str, dest: str, say=print) -> int:
+    """Unpacks every task_I.tar.gz of `packs` into `dest`, in task order, each checked; the number of tasks."""
     names = sorted((n for n in os.listdir(packs) if n.endswith(".tar.gz")),
                    key=lambda n: int(n[len("task_"):-len(".tar.gz")]))
     if not names:
         sys.exit(f"table_unpack: {packs}: no task_I.tar.gz archives")
     os.makedirs(dest, exist_ok=True)
     for name in names:
-        print(f"table_unpack: {name}: {unpack(packs, name, dest)} files checked")
-    print(f"table_unpack: {len(names)} tasks in {dest}; then: python3 -m kage.bench report {dest}")
+        say(f"table_unpack: {name}: {unpack(packs, name, dest)} files checked")
+    return len(names)
+
+
+def main() -> None:
+    if len(sys.argv) != 3:
+        sys.exit(__doc__.splitlines()[-1])
+    packs, dest = sys.argv[1:]
+    tasks = unpack_all(packs, dest)
+    print(f"table_unpack: {tasks} tasks in {dest}; then: python3 -m kage.bench report {dest}")
 
 
 if __name__ == "__main__":
