@@ -34,15 +34,17 @@ if [ -n "${IDLE_GPU:-}" ]; then
    echo "rc=$? ($(date -u +%H:%M:%S) UTC)" >>"$log"
    old=/tmp/kage-before-step-batches
    rm -rf "$old" && cp -a "$PYTHONPATH" "$old" && cp "$here"/.old-ppo/evaluation.py "$here"/.old-ppo/train.py "$old/kage/ppo/"
-   evals=$(printf 'configs/kage_bench/%s-eval.yaml ' background/9 filters/1 filters/2 filters/3 filters/4 filters/5 \
-     filters/6 filters/7 filters/8 filters/9)
+   pairs="background/9 filters/1 filters/2 filters/3 filters/4 filters/5 filters/6 filters/7 filters/8 filters/9"
+   # shellcheck disable=SC2086
+   evals=$(printf 'configs/kage_bench/%s-eval.yaml ' $pairs)
+   labels=${pairs//\//_}  # two eval files share a name (9-eval.yaml): the trainer wants labels
    for variant in before after; do
      path=$PYTHONPATH; [ "$variant" = before ] && path=$old
      echo "== speed $variant kage.step_batches, GPU $IDLE_GPU ($(date -u +%H:%M:%S) UTC)" >>"$log"
      # shellcheck disable=SC2086
      CUDA_VISIBLE_DEVICES=$IDLE_GPU PYTHONPATH=$path timeout 150 python3 -m kage.bench speed --packs 10 --warmup 2 \
        --iterations 3 --json /tmp/speed_$variant.jsonl $FLAGS \
-       --train-config-path configs/kage_bench/bases/image_skeleton.yaml --eval-config-paths $evals >>"$log" 2>&1
+       --train-config-path configs/kage_bench/bases/image_skeleton.yaml --eval-config-paths $evals --eval-config-labels $labels >>"$log" 2>&1
      echo "rc=$?" >>"$log"; cat /tmp/speed_$variant.jsonl >>"$log" 2>/dev/null
    done) &
   extras=$!
