@@ -25,6 +25,12 @@ static_assert(std::size(kDTypes) == static_cast<size_t>(kage::DType::kBool) + 1,
 const DTypeFacts& facts(kage::DType t) { return kDTypes[static_cast<size_t>(t)]; }
 py::dtype numpy_dtype(kage::DType t) { return py::dtype(facts(t).typestr); }
 
+std::string shape_text(const DLTensor& t) {
+  std::string s = "(";
+  for (int32_t i = 0; i < t.ndim; ++i) s += std::to_string(t.shape[i]) + (t.ndim == 1 || i + 1 < t.ndim ? "," : "");
+  return s + ")";
+}
+
 py::capsule DeviceArray::dlpack(const py::object& consumer_stream) const {
   const int64_t s = consumer_stream.is_none() ? 1 : consumer_stream.cast<int64_t>();
   if (s == 0) throw py::value_error("__dlpack__: stream 0 is ambiguous for CUDA; pass 1 for the legacy default stream");

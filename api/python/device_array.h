@@ -1,6 +1,6 @@
 // The Python binding's array of a GPU batch's output: device memory owned by the batch, exported without a
 // copy through DLPack and __cuda_array_interface__, or copied to the host; and each kage::DType as numpy,
-// DLPack and __array_interface__ name it.
+// DLPack and __array_interface__ name it; a DLPack tensor's shape as an error names it.
 #pragma once
 
 #include <dlpack/dlpack.h>
@@ -24,6 +24,8 @@ struct DTypeFacts {
 };
 const DTypeFacts& facts(kage::DType t);
 pybind11::dtype numpy_dtype(kage::DType t);
+/// A DLPack tensor's shape as text for an error: "(6,)", "(2,6)".
+std::string shape_text(const DLTensor& t);
 
 /// One output array of a batch on the GPU: device memory owned by the batch.
 class DeviceArray {

@@ -10,7 +10,6 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <algorithm>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -20,6 +19,7 @@
 #include "api/python/device_array.h"
 #include "api/python/front_end.h"
 #include "api/python/paths.h"
+#include "api/python/step_rows.h"
 #include "kage/kage.h"
 
 namespace py = pybind11;
@@ -49,6 +49,7 @@ py::str text(const std::string& s) {
 using kage::python::DeviceArray;
 using kage::python::facts;
 using kage::python::numpy_dtype;
+using kage::python::shape_text;
 
 /// A batch as Python sees it: kage::Env plus the export of its outputs.
 ///
@@ -180,40 +181,17 @@ class PyEnv {
     if (!problem.empty()) raise_value_error(problem);
   }
 
-  /// Steps envs[i] with row i of `actions` ([len(envs), num_envs], int32 or int64), each as its own step call
-  /// would: one call into the runtime for a list of batches (a pack's runs, an evaluation's configs). Host
-  /// actions: a 2-D numpy array, native and aligned (kage.actions copies other layouts first). Device actions: a
-  /// DLPack capsule its producer ordered for envs[0]'s stream; the batches' other streams are ordered after that
-  /// one before any batch steps, so that they still step side by side. A failure leaves the earlier rows stepped.
+  /// kage::python::step_rows over these batches, each stepped by its own step; a failure names its batch.
   static void step_rows(const std::vector<PyEnv*>& envs, const py::object& actions) {
-    if (envs.empty()) raise_value_error("step_rows: no batches");
-    const int32_t n = envs[0]->num_envs();
-    for (size_t i = 0; i < envs.size(); ++i)
-      if (envs[i]->num_envs() != n)
-        raise_value_error("batch " + std::to_string(i) + " has " + std::to_string(envs[i]->num_envs()) +
-                          " environments, batch 0 has " + std::to_string(n) + ": step batches of one size together");
-    if (py::isinstance<py::array>(actions)) return step_host_rows(envs, actions.cast<py::array>(), n);
-    auto* t = static_cast<DLManagedTensor*>(PyCapsule_GetPointer(actions.ptr(), "dltensor"));
-    if (!t) throw py::error_already_set();
-    const DLTensor& d = t->dl_tensor;
-    const std::string problem = device_rows_problem(envs, d, n);
-    PyCapsule_SetName(actions.ptr(), "used_dltensor");  // ours now: freed below, after the launches
-    try {
-      if (problem.empty()) {
-        const int64_t item = d.dtype.bits / 8, row_stride = d.strides ? d.strides[0] : n;
-        const int64_t stride = d.strides ? d.strides[1] : 1;
-        const char* data = static_cast<const char*>(d.data) + d.byte_offset;
-        order_streams_after_first(envs);
-        for (size_t i = 0; i < envs.size(); ++i)
-          envs[i]->run_step(kage::Actions{data + static_cast<int64_t>(i) * row_stride * item, kage::Memory::kDevice,
-                                          item == 8 ? kage::DType::kInt64 : kage::DType::kInt32, stride});
-      }
-    } catch (...) {
-      if (t->deleter) t->deleter(t);
-      throw;
-    }
-    if (t->deleter) t->deleter(t);
-    if (!problem.empty()) raise_value_error(problem);
+    std::vector<kage::python::RowBatch> batches;
+    for (PyEnv* env : envs)
+      batches.push_back({env->num_envs(), env->device() == "cuda", reinterpret_cast<void*>(env->stream()),
+                         [env, rows = envs.size()](size_t row, const kage::Actions& a) {
+                           Outcome o = env->locked([&](kage::Env& e) { return step_locked(e, a); });
+                           if (!o.ok) o.error = kage::python::row_failure(row, rows, o.error);
+                           raise_if_failed(o);
+                         }});
+    kage::python::step_rows(batches, actions);
   }
 
   py::bytes save_state() const {
@@ -377,12 +355,6 @@ class PyEnv {
                         std::to_string(got));
   }
 
-  static std::string shape_text(const DLTensor& d) {
-    std::string s = "(";
-    for (int32_t i = 0; i < d.ndim; ++i) s += std::to_string(d.shape[i]) + (d.ndim == 1 || i + 1 < d.ndim ? "," : "");
-    return s + ")";
-  }
-
   /// A failed reset, step or synchronize, raised by the kind the runtime reports: an action outside 0..7 as
   /// the package's usage error class (ValueError), anything else as its other class (RuntimeError).
   static void raise_if_failed(const Outcome& o) {
@@ -402,55 +374,6 @@ class PyEnv {
 
   void run_step(const kage::Actions& a) {
     raise_if_failed(locked([&](kage::Env& e) { return step_locked(e, a); }));
-  }
-
-  static void step_host_rows(const std::vector<PyEnv*>& envs, const py::array& a, int32_t n) {
-    const auto& dt = a.dtype();
-    const py::ssize_t item = dt.itemsize();
-    if (dt.kind() != 'i' || (item != 4 && item != 8) || a.ndim() != 2 || !dt.attr("isnative").cast<bool>() ||
-        a.strides(0) % item != 0 || a.strides(1) % item != 0 || reinterpret_cast<uintptr_t>(a.data()) % item != 0)
-      raise_value_error("internal: step_rows wants a 2-D native, aligned int32 or int64 array");
-    if (a.shape(0) != static_cast<py::ssize_t>(envs.size()) || a.shape(1) != n)
-      raise_value_error("actions of shape (" + std::to_string(a.shape(0)) + ", " + std::to_string(a.shape(1)) +
-                        "), expected (" + std::to_string(envs.size()) + ", " + std::to_string(n) +
-                        "): a row of one action per environment for each batch");
-    const char* data = static_cast<const char*>(a.data());
-    for (size_t i = 0; i < envs.size(); ++i)
-      envs[i]->run_step(kage::Actions{data + static_cast<py::ssize_t>(i) * a.strides(0), kage::Memory::kHost,
-                                      item == 8 ? kage::DType::kInt64 : kage::DType::kInt32, a.strides(1) / item});
-  }
-
-  /// What keeps device actions `d` from stepping `envs` (n environments each) by rows; empty if nothing.
-  static std::string device_rows_problem(const std::vector<PyEnv*>& envs, const DLTensor& d, int32_t n) {
-    for (size_t i = 0; i < envs.size(); ++i)
-      if (envs[i]->device() != "cuda")
-        return "actions are in GPU memory but batch " + std::to_string(i) + " runs on the CPU: pass host actions "
-               "(e.g. actions.cpu()) or make the batches with device='cuda'";
-    if (d.device.device_type != kDLCUDA || d.device.device_id != 0)
-      return "actions on DLPack device (" + std::to_string(d.device.device_type) + ", " +
-             std::to_string(d.device.device_id) + "), the environments run on cuda:0";
-    if (d.ndim != 2 || d.shape[0] != static_cast<int64_t>(envs.size()) || d.shape[1] != n)
-      return "actions of shape " + shape_text(d) + ", expected (" + std::to_string(envs.size()) + ", " +
-             std::to_string(n) + "): a row of one action per environment for each batch";
-    if (d.dtype.lanes != 1 || d.dtype.code != kDLInt || (d.dtype.bits != 32 && d.dtype.bits != 64))
-      return "actions of DLPack type (code " + std::to_string(d.dtype.code) + ", " + std::to_string(d.dtype.bits) +
-             " bits), expected int32 or int64";
-    if ((reinterpret_cast<uintptr_t>(d.data) + d.byte_offset) % (d.dtype.bits / 8) != 0)
-      return "actions: device data not aligned to the item size: pass a contiguous copy (e.g. actions.contiguous())";
-    return "";
-  }
-
-  /// Makes every batch's stream wait for what envs[0]'s stream has queued so far (the actions' producer).
-  static void order_streams_after_first(const std::vector<PyEnv*>& envs) {
-    void* first = reinterpret_cast<void*>(envs[0]->stream());
-    std::vector<void*> ordered{first};
-    for (PyEnv* env : envs) {
-      void* s = reinterpret_cast<void*>(env->stream());
-      if (std::find(ordered.begin(), ordered.end(), s) != ordered.end()) continue;
-      std::string error;
-      if (!kage::python::order_after(first, s, &error)) throw std::runtime_error(error);
-      ordered.push_back(s);
-    }
   }
 
   std::shared_ptr<kage::Env> env_;

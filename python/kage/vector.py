@@ -397,7 +397,9 @@ def step_batches(envs: Sequence[VecEnv], actions) -> None:
     the runtime: for a learner that steps many batches (a pack's runs, an evaluation's configs) every step, where
     one Python call per batch would cost more than the batches' kernels. ``actions``: [len(envs), num_envs]
     integers, host or GPU as ``step`` takes them; the batches must have one size. Read the outputs with
-    ``outputs()``, the views ``step`` returns."""
+    ``outputs()``, the views ``step`` returns. What ``step`` would refuse before stepping (a shape, a dtype, a
+    device) is refused before any batch steps; a batch whose own step fails (an action outside 0..7 in its row)
+    raises that error, naming the batch; the batches before it have stepped."""
     envs = list(envs)
     if not envs or not all(isinstance(env, VecEnv) for env in envs):
         raise TypeError("step_batches: a non-empty list of kage.VecEnv (from kage.make_vec)")

@@ -1,6 +1,6 @@
 """kage.step_batches: a list of batches stepped by rows of one actions array in one call equals each batch stepped
 alone with its row, byte for byte (observations, rewards, flags, info and final info, across autoresets, a mixture
-among them), and every misuse is refused before any batch steps."""
+among them); every misuse is refused before any batch steps, and a bad action found in a later row names its batch."""
 import numpy as np
 import pytest
 import torch
@@ -87,6 +87,25 @@ def test_misuse_is_refused_before_any_batch_steps(envs, actions, error, text):
     assert text in str(raised.value)
     for env, obs in zip(made, before):
         assert np.array_equal(snapshot(env)["obs"], obs)
+
+
+def test_a_bad_action_in_a_later_row_names_its_batch_and_leaves_the_earlier_batches_stepped():
+    made, alone = batches(), batches()
+    for env in made + alone:
+        env.reset()
+    rows = policy(9, 4 * N, 1)[0].reshape(4, N)
+    rows[2, 3] = 8
+    before = [snapshot(env)["obs"] for env in made]
+    with pytest.raises(ValueError) as raised:
+        kage.step_batches(made, rows)
+    assert ("batch 2 of 4 (the 2 before it stepped, the rest did not): action 8 for environment 3: an action is an "
+            "integer in 0..7") in str(raised.value)
+    for env, row in zip(alone[:2], rows):
+        env.step(row)
+    for k in range(4):
+        expected = snapshot(alone[k])["obs"] if k < 2 else before[k]
+        assert np.array_equal(snapshot(made[k])["obs"], expected), k
+    assert not np.array_equal(before[0], snapshot(made[0])["obs"])  # batch 0 did step
 
 
 def test_a_closed_batch_is_refused():
