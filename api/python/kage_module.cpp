@@ -184,13 +184,16 @@ class PyEnv {
   /// kage::python::step_rows over these batches, each stepped by its own step; a failure names its batch.
   static void step_rows(const std::vector<PyEnv*>& envs, const py::object& actions) {
     std::vector<kage::python::RowBatch> batches;
-    for (PyEnv* env : envs)
-      batches.push_back({env->num_envs(), env->device() == "cuda", reinterpret_cast<void*>(env->stream()),
-                         [env, rows = envs.size()](size_t row, const kage::Actions& a) {
-                           Outcome o = env->locked([&](kage::Env& e) { return step_locked(e, a); });
-                           if (!o.ok) o.error = kage::python::row_failure(row, rows, o.error);
-                           raise_if_failed(o);
-                         }});
+    for (PyEnv* env : envs) {
+      auto step = [env, rows = envs.size()](size_t row, const kage::Actions& a) {
+        Outcome o = env->locked([&](kage::Env& e) { return step_locked(e, a); });
+        if (!o.ok) o.error = kage::python::row_failure(row, rows, o.error);
+        raise_if_failed(o);
+      };
+      batches.push_back(env->locked([&](kage::Env& e) {  // one lock a batch: this runs every step
+        return kage::python::RowBatch{e.num_envs(), e.backend() == kage::Backend::kGpu, e.stream(), step};
+      }));
+    }
     kage::python::step_rows(batches, actions);
   }
 
