@@ -3,7 +3,7 @@
 # kage.step_batches checked on the GPU before any run uses it, and, once a GPU is idle, the GPU tests and the
 # evaluation's speed before and after kage.step_batches. Run from the repository root with carry [".deps",
 # ".old-ppo"] (.old-ppo: python/kage/ppo/evaluation.py and train.py of the commit before kage.step_batches):
-#   CALL=1 COMMIT=... TASKS=0,1 bash lab/2026-11-28-rollout-jitter-lease/lease_device.sh   # check, then start
+#   CALL=1 COMMIT=... TASKS=0,1 bash lab/2026-11-28-h200-rollout-jitter-table/lease_device.sh   # check, then start
 #   CALL=2 COMMIT=... TASKS=0,1 bash ...                                                  # wait and pack
 #   CALL=3 IDLE_GPU=0 COMMIT=... TASKS=0,1 bash ...        # wait and pack; the tests and speed on IDLE_GPU
 set -uo pipefail
