@@ -93,8 +93,12 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     # Everything that can be refused is checked before a run directory is written: the configs, the batches
     # (their size against the memory), the agent and the augmentation (each called once on blank frames), and
     # the rollout's storage against the device's free memory.
+    opening = time.perf_counter()
     runs = [open_batches(a, threads) for a in pack]
     K, T, N = len(runs), args.num_steps, args.num_envs
+    # A pack's start can take minutes (a batch per run and config): the log says how long, for the lease plans.
+    print(f"kage.ppo.train: {sum(1 + len(run.eval_envs) for run in runs)} batches of {K} runs opened in "
+          f"{time.perf_counter() - opening:.1f} s", file=sys.stderr)
     height, width, channels = runs[0].env.single_observation_space.shape
     channels *= 4 if args.use_frame_stack else 1
     num_actions = runs[0].env.single_action_space.n
