@@ -196,10 +196,10 @@ def main(argv: Optional[List[str]] = None) -> int:
                                                        f"{readme} (written)", "from the packs now"))
             fail(f"{readme}: its tables are not those of the packs now (diff above): run python3 {TOOL}"
                  f"{'' if args.methods_root == METHODS_ROOT else ' --methods-root ' + args.methods_root} and commit")
-        print(f"methods_tables: {readme}: the tables are those of the packs ({len(methods)} methods)")
+        print(f"methods_tables: {readme}: the tables are those of the packs (methods: {', '.join(methods) or 'none'})")
         return 0
     atomic_write(readme, generated_block.replaced(page, block, TOOL, readme).encode())
-    print(f"methods_tables: wrote the tables of {len(methods)} methods into {readme}")
+    print(f"methods_tables: wrote the tables of {', '.join(methods) or 'no method'} into {readme}")
     return 0
 
 
