@@ -17,11 +17,7 @@ _DLPACK_CPU, _DLPACK_CUDA, _DLPACK_CUDA_HOST, _DLPACK_CUDA_MANAGED = 1, 2, 3, 13
 def submit(handle, actions) -> None:
     """Steps ``handle`` with ``actions``; raises ValueError for a wrong shape, dtype, device or value."""
     n = handle.num_envs
-    if isinstance(actions, np.ma.MaskedArray):  # an ndarray whose hidden values the binding would read
-        if np.ma.getmaskarray(actions).any():
-            raise ValueError("actions: a masked array with masked elements: fill them (actions.filled(value)) or "
-                             "pass a plain array")
-        actions = actions.data
+    actions = _unmasked(actions)
     if hasattr(actions, "__dlpack_device__"):
         device_type, _ = actions.__dlpack_device__()
         if device_type in (_DLPACK_CUDA, _DLPACK_CUDA_MANAGED):
@@ -40,6 +36,16 @@ def submit(handle, actions) -> None:
         _step_cuda_array_interface(handle, actions.__cuda_array_interface__, n)
         return
     _step_host(handle, np.asarray(actions), n)
+
+
+def _unmasked(actions):
+    """A masked array's data, refused where any element is masked (the binding would read the hidden values)."""
+    if isinstance(actions, np.ma.MaskedArray):
+        if np.ma.getmaskarray(actions).any():
+            raise ValueError("actions: a masked array with masked elements: fill them (actions.filled(value)) or "
+                             "pass a plain array")
+        return actions.data
+    return actions
 
 
 def _host_array(actions) -> np.ndarray:
@@ -88,11 +94,7 @@ def submit_rows(handles, actions) -> None:
     num_envs environments): ``actions`` [len(handles), num_envs], host or GPU, as ``submit`` takes one row.
     GPU actions are ordered for the first batch's stream; the runtime orders the others' after it."""
     shape = (len(handles), handles[0].num_envs)
-    if isinstance(actions, np.ma.MaskedArray):
-        if np.ma.getmaskarray(actions).any():
-            raise ValueError("actions: a masked array with masked elements: fill them (actions.filled(value)) or "
-                             "pass a plain array")
-        actions = actions.data
+    actions = _unmasked(actions)
     if hasattr(actions, "__dlpack_device__"):
         device_type, _ = actions.__dlpack_device__()
         if device_type in (_DLPACK_CUDA, _DLPACK_CUDA_MANAGED):

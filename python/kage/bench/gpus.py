@@ -39,17 +39,8 @@ def parse_gpus(text: str, trainer_device: str) -> List[str]:
         raise SystemExit("kage.bench run: --gpus, but torch sees no CUDA GPU: run without --gpus (one process)")
     if trainer_device != "cuda" and os.environ.get(FAKE_GPUS) is None:
         raise SystemExit(f"kage.bench run: --gpus trains on the GPUs: remove --device {trainer_device}, or --gpus")
-    if text == "all":
-        indices = list(range(count))
-    else:
-        try:
-            indices = [int(part) for part in text.split(",")]
-        except ValueError:
-            raise SystemExit(f"kage.bench run: --gpus {text}: use 'all' or GPU indices like 0,2") from None
-        bad = [i for i in indices if not 0 <= i < count]
-        if bad or len(set(indices)) != len(indices):
-            raise SystemExit(f"kage.bench run: --gpus {text}: this machine's GPUs are 0 to {count - 1}, each named "
-                             "once")
+    indices = list(range(count)) if text == "all" else index_list(
+        "--gpus", text, count, "use 'all' or GPU indices like 0,2", "this machine's GPUs are")
     outer = os.environ.get("CUDA_VISIBLE_DEVICES")
     visible = outer.split(",") if outer and os.environ.get(FAKE_GPUS) is None else None
     return [visible[i] if visible else str(i) for i in indices]
@@ -89,15 +80,19 @@ def parse_tasks(text: Optional[str], count: int, out: str) -> Optional[List[int]
     """--tasks '0,3,4' -> [0, 3, 4], each an index of the task table of `count` tasks (None: every task)."""
     if text is None:
         return None
+    return index_list("--tasks", text, count, f"use task indices like 0,3,4 (see {out}/tasks.json)",
+                      f"the task table of {out} has {count} tasks,", " (see tasks.json)")
+
+
+def index_list(flag: str, text: str, count: int, usage: str, extent: str, see: str = "") -> List[int]:
+    """`flag`'s '0,2' -> [0, 2]: distinct indices below `count`, or an error naming the flag and the fix."""
     try:
-        chosen = [int(part) for part in text.split(",")]
+        indices = [int(part) for part in text.split(",")]
     except ValueError:
-        raise SystemExit(f"kage.bench run: --tasks {text}: use task indices like 0,3,4 (see {out}/tasks.json)") from None
-    bad = [i for i in chosen if not 0 <= i < count]
-    if bad or len(set(chosen)) != len(chosen):
-        raise SystemExit(f"kage.bench run: --tasks {text}: the task table of {out} has {count} tasks, 0 to {count - 1}, "
-                         "each named once (see tasks.json)")
-    return chosen
+        raise SystemExit(f"kage.bench run: {flag} {text}: {usage}") from None
+    if any(not 0 <= i < count for i in indices) or len(set(indices)) != len(indices):
+        raise SystemExit(f"kage.bench run: {flag} {text}: {extent} 0 to {count - 1}, each named once{see}")
+    return indices
 
 
 def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: Optional[List[int]] = None) -> int:
