@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iterator>
+#include <set>
 #include <sstream>
 
 #include "api/environment.h"
@@ -21,6 +22,7 @@
 #if defined(KAGE_API_HAVE_CUDA)
 #include "compiler/codegen/build.h"
 #include "runtime/cuda/device_batch.h"
+#include "runtime/cuda/parallel_compile.h"
 #endif
 
 namespace kage {
@@ -354,15 +356,24 @@ class GpuEnv final : public Env {
   std::vector<int32_t> actions_;
 };
 
+/// NVRTC's options for a config's generated source: the runtime headers beside the package, the generator's
+/// version (both in the kernel cache's key).
+NvrtcOptions loader_options() {
+  NvrtcOptions no;
+  no.include_dir = runtime_include_dir();
+  no.generator_version = std::to_string(kCodegenVersion);
+  return no;
+}
+
+/// The name of a config's generated source in NVRTC's diagnostics.
+std::string source_name(const std::string& spec_hash) { return "kage_" + spec_hash.substr(0, 16) + ".cu"; }
+
 /// The module of one config: its fatbin when given, else NVRTC on its generated `source` (through the
 /// kernel cache). Each call loads a module of its own, with its own __constant__ parameters.
 std::optional<CudaModule> gpu_module(const std::string& spec_hash, const std::string& source, const std::string& fatbin,
                                      std::string* error) {
   if (!fatbin.empty()) return CudaModule::load_file(fatbin, error);
-  NvrtcOptions no;
-  no.include_dir = runtime_include_dir();
-  no.generator_version = std::to_string(kCodegenVersion);
-  return CudaModule::compile(source, "kage_" + spec_hash.substr(0, 16) + ".cu", no, error);
+  return CudaModule::compile(source, source_name(spec_hash), loader_options(), error);
 }
 
 /// One config of a GPU batch: its Spec hash and lowered parameters, its generated source (or fatbin path),
@@ -583,6 +594,48 @@ const char* action_range_text() { return "an action is an integer in 0..7 (bit 0
 const InfoFieldDesc* info_fields(int32_t* count) {
   *count = static_cast<int32_t>(std::size(kInfoFields));
   return kInfoFields;
+}
+
+std::optional<KernelsCompiled> compile_kernels(const std::vector<std::string>& paths, const Options& o,
+                                               std::string* error, ErrorKind* kind_out) {
+  ErrorKind ignored = ErrorKind::kOther;
+  ErrorKind* kind = kind_out ? kind_out : &ignored;
+#if !defined(KAGE_API_HAVE_CUDA)
+  (void)paths;
+  (void)o;
+  *kind = ErrorKind::kDevice;
+  fail(error, "kage::compile_kernels: GPU backend not built (no CUDA toolkit at build time)");
+  return std::nullopt;
+#else
+  std::vector<KernelJob> jobs;
+  std::vector<std::string> job_paths;
+  std::set<std::string> seen;  // Spec hashes: a config named twice, or by two paths, compiles once
+  for (const std::string& path : paths) {
+    std::optional<Loaded> l = load_yaml(path, o, error);
+    if (!l) return *kind = ErrorKind::kConfig, std::nullopt;
+    if (!seen.insert(l->spec_hash).second) continue;
+    KernelJob job;
+    job.source = generate_source({l->spec_hash, l->config.latent, l->config.visual}).text;
+    job.name = source_name(l->spec_hash);
+    jobs.push_back(std::move(job));
+    job_paths.push_back(path);
+  }
+  if (jobs.empty()) return *kind = ErrorKind::kNone, KernelsCompiled{};
+  const std::optional<std::string> arch = device_arch(error);
+  if (!arch) return *kind = ErrorKind::kDevice, std::nullopt;
+  compile_jobs(jobs, loader_options(), *arch, compile_threads(jobs.size()));
+  KernelsCompiled done;
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    if (!jobs[i].cubin) {
+      *kind = ErrorKind::kOther;
+      fail(error, "kage::compile_kernels: '" + job_paths[i] + "': " + jobs[i].error);
+      return std::nullopt;
+    }
+    ++(jobs[i].cached ? done.cached : done.compiled);
+  }
+  *kind = ErrorKind::kNone;
+  return done;
+#endif
 }
 
 bool gpu_backend_built() {

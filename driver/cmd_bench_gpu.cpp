@@ -1,10 +1,6 @@
 // kagec bench --gpu (cmd_bench_gpu.h): configs compiled by NVRTC, timed by verify/throughput/gpu_measure.h.
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cstdio>
-#include <mutex>
-#include <thread>
 #include <set>
 #include <optional>
 #include <ostream>
@@ -20,6 +16,7 @@
 #include "driver/cmd_bench_gpu.h"
 #include "compiler/lower/lower.h"
 #include "runtime/io/asset_pack.h"
+#include "runtime/cuda/parallel_compile.h"
 #include "verify/throughput/gpu_measure.h"
 
 namespace kage {
@@ -92,11 +89,7 @@ std::string fixed(double v, int digits) {
 struct Job {
   std::string label;
   LoweredConfig config;
-  GeneratedSource source;
-  std::optional<std::string> cubin;
-  std::string error;
-  bool cached = false;
-  double seconds = 0;
+  KernelJob kernels;
 };
 
 std::optional<Job> make_job(const std::string& label, const Spec& spec, std::string* error) {
@@ -105,37 +98,28 @@ std::optional<Job> make_job(const std::string& label, const Spec& spec, std::str
     *error = "the runtime cannot hold this config (kagec lint says why)";
     return std::nullopt;
   }
-  Job j{label, *lowered.config, generate_source({spec.sha256(), lowered.config->latent, lowered.config->visual}),
-        std::nullopt, "", false, 0};
+  GeneratedSource source = generate_source({spec.sha256(), lowered.config->latent, lowered.config->visual});
+  Job j{label, *lowered.config, KernelJob{}};
+  j.kernels.source = std::move(source.text);
+  j.kernels.name = std::move(source.file_name);
   return j;
 }
 
-/// Fills every job's cubin, from the kernel cache or NVRTC, on several threads (NVRTC compiles one
-/// program per call, so configs compile side by side); one line on `progress` per finished config.
-void compile_all(std::vector<Job>& jobs, std::ostream& progress) {
+/// Fills every job's cubin for `arch`, from the kernel cache or NVRTC, configs side by side; one line on
+/// `progress` per finished config.
+void compile_all(std::vector<Job>& jobs, const std::string& arch, std::ostream& progress) {
   NvrtcOptions no;
   no.include_dir = runtime_include_dir();
   no.generator_version = std::to_string(kCodegenVersion);
-  std::atomic<size_t> next{0};
-  std::mutex mutex;
-  size_t done = 0;
-  auto work = [&] {
-    for (size_t i = next++; i < jobs.size(); i = next++) {
-      Job& j = jobs[i];
-      const auto start = std::chrono::steady_clock::now();
-      j.cubin = cubin_for(j.source.text, j.source.file_name, no, &j.error, &j.cached);
-      j.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const std::lock_guard<std::mutex> lock(mutex);
-      progress << "kagec bench: config " << ++done << " of " << jobs.size() << ", " << j.label << ": "
-               << (!j.cubin ? "FAILED" : j.cached ? "cached" : "compiled in " + fixed(j.seconds, 1) + " s") << '\n'
-               << std::flush;
-    }
-  };
-  const size_t threads = std::clamp<size_t>(std::thread::hardware_concurrency(), 1, std::min<size_t>(jobs.size(), 8));
-  std::vector<std::thread> pool;
-  for (size_t t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+  std::vector<KernelJob> kernels;
+  for (Job& j : jobs) kernels.push_back(std::move(j.kernels));
+  compile_jobs(kernels, no, arch, compile_threads(kernels.size()), [&](const KernelJob& k, size_t done) {
+    progress << "kagec bench: config " << done << " of " << jobs.size() << ", "
+             << jobs[static_cast<size_t>(&k - kernels.data())].label << ": "
+             << (!k.cubin ? "FAILED" : k.cached ? "cached" : "compiled in " + fixed(k.seconds, 1) + " s") << '\n'
+             << std::flush;
+  });
+  for (size_t i = 0; i < jobs.size(); ++i) jobs[i].kernels = std::move(kernels[i]);
 }
 
 }  // namespace
@@ -160,11 +144,16 @@ int bench_gpu(const GpuBenchOptions& o, CommandIo& io) {
     }
     jobs.push_back(std::move(*j));
   }
-  compile_all(jobs, io.err);
+  const std::optional<std::string> arch = device_arch(&error);
+  if (!arch) {
+    io.err << "kagec bench --gpu: " << error << '\n';
+    return kExitErrors;
+  }
+  compile_all(jobs, *arch, io.err);
   size_t failed = 0;
   for (const Job& j : jobs) {
-    if (j.cubin) continue;
-    io.err << "kagec bench --gpu: " << j.label << ": " << j.error << '\n';
+    if (j.kernels.cubin) continue;
+    io.err << "kagec bench --gpu: " << j.label << ": " << j.kernels.error << '\n';
     ++failed;
   }
   if (failed) {
@@ -183,7 +172,7 @@ int bench_gpu(const GpuBenchOptions& o, CommandIo& io) {
               "|---|---|---|---|---|---|\n"
            << std::flush;
     for (const Job& j : jobs) {
-      std::optional<CudaModule> module = CudaModule::load_image(j.cubin->data(), &error);
+      std::optional<CudaModule> module = CudaModule::load_image(j.kernels.cubin->data(), &error);
       if (!module) throw throughput::MeasureError(j.label + ": " + error);
       AssetPackResult assets = load_asset_pack(j.config.assets);
       if (!assets.ok()) throw throughput::MeasureError(j.label + ": " + assets.error);

@@ -383,6 +383,18 @@ class PyEnv {
   std::shared_ptr<std::mutex> mutex_;  // shared: PyEnv is moved once, out of open_env
 };
 
+/// Raises `error` as the exception class of its kind.
+[[noreturn]] void raise_kind(kage::ErrorKind kind, const std::string& error) {
+  const ErrorClasses& e = error_classes();
+  const py::object& cls = kind == kage::ErrorKind::kConfig   ? e.config
+                          : kind == kage::ErrorKind::kFile   ? e.file
+                          : kind == kage::ErrorKind::kDevice ? e.device
+                          : kind == kage::ErrorKind::kUsage  ? e.usage
+                                                             : e.other;
+  PyErr_SetObject(cls.ptr(), text(error).ptr());
+  throw py::error_already_set();
+}
+
 /// The batch `open_fn(error, kind)` opens (without the GIL), or its failure raised as the class of its kind.
 template <class Open>
 PyEnv opened(const Open& open_fn) {
@@ -393,15 +405,24 @@ PyEnv opened(const Open& open_fn) {
     py::gil_scoped_release release;
     env = open_fn(&error, &kind);
   }
-  if (env) return PyEnv(std::shared_ptr<kage::Env>(std::move(env)));
-  const ErrorClasses& e = error_classes();
-  const py::object& cls = kind == kage::ErrorKind::kConfig   ? e.config
-                          : kind == kage::ErrorKind::kFile   ? e.file
-                          : kind == kage::ErrorKind::kDevice ? e.device
-                          : kind == kage::ErrorKind::kUsage  ? e.usage
-                                                             : e.other;
-  PyErr_SetObject(cls.ptr(), text(error).ptr());
-  throw py::error_already_set();
+  if (!env) raise_kind(kind, error);
+  return PyEnv(std::shared_ptr<kage::Env>(std::move(env)));
+}
+
+/// kage::compile_kernels without the GIL: (compiled, cached), or its failure raised as the class of its kind.
+py::tuple compile_kernels(const std::vector<std::string>& paths, const std::string& asset_root) {
+  kage::Options o;
+  o.backend = kage::Backend::kGpu;
+  o.asset_root = asset_root;
+  std::string error;
+  kage::ErrorKind kind = kage::ErrorKind::kOther;
+  std::optional<kage::KernelsCompiled> done;
+  {
+    py::gil_scoped_release release;
+    done = kage::compile_kernels(paths, o, &error, &kind);
+  }
+  if (!done) raise_kind(kind, error);
+  return py::make_tuple(done->compiled, done->cached);
 }
 
 PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& device, int32_t num_threads,
@@ -494,6 +515,9 @@ PYBIND11_MODULE(_kage, m) {
   m.def("step_rows", &PyEnv::step_rows, py::arg("envs"), py::arg("actions"),
         "Steps envs[i] with row i of actions (a 2-D numpy array, or a DLPack capsule ordered for envs[0]'s "
         "stream) in one call.");
+  m.def("compile_kernels", &compile_kernels, py::arg("paths"), py::arg("asset_root"),
+        "kage::compile_kernels: the configs' GPU kernels compiled into the kernel cache, side by side; "
+        "(compiled, cached).");
   m.def("open_mixture", &open_mixture, py::arg("paths"), py::arg("counts"), py::arg("device"), py::arg("num_threads"),
         py::arg("asset_root"), py::arg("stream"));
 

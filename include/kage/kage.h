@@ -26,6 +26,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -191,6 +192,22 @@ struct MixturePart {
 /// --mixture).
 std::unique_ptr<Env> open_mixture(const std::vector<MixturePart>& parts, const Options& options, std::string* error,
                                   ErrorKind* kind = nullptr);
+
+/// What compile_kernels did: how many configs' kernels NVRTC compiled, and how many the kernel cache held.
+struct KernelsCompiled {
+  int32_t compiled = 0;
+  int32_t cached = 0;
+};
+
+/// Compiles the GPU kernels of the YAML configs `paths` for device 0 into the kernel cache ($KAGE_CACHE_DIR,
+/// else ~/.cache/kagec), several configs at once (one per core, up to 16), so that opening their batches
+/// afterwards (open, open_mixture with the GPU backend) takes their kernels from the cache instead of
+/// compiling one config after another. A config given twice is compiled once. options.asset_root resolves the
+/// configs as open would; the other options are ignored. Every config is loaded before anything compiles: a
+/// config with errors fails with its located diagnostics and path (kind kConfig), then a missing GPU (kDevice);
+/// no configs need no GPU.
+std::optional<KernelsCompiled> compile_kernels(const std::vector<std::string>& paths, const Options& options,
+                                               std::string* error, ErrorKind* kind = nullptr);
 
 /// Whether this build can run the GPU backend (the CUDA runtime pieces were compiled in).
 bool gpu_backend_built();

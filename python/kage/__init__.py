@@ -2,7 +2,8 @@
 learner, and the front end's checks of configs and suites.
 
 The package has three layers, each importing only those below it:
-- ``kage`` (this package): the environment API (``make_vec``, ``VecEnv``, spaces, errors, ``kage.front_end``);
+- ``kage`` (this package): the environment API (``make_vec``, ``VecEnv``, ``compile_kernels``, spaces, errors,
+  ``kage.front_end``);
 - ``kage.ppo``: the PPO-CNN baseline (``python3 -m kage.ppo.train``, ``python3 -m kage.ppo.evaluate``);
 - ``kage.bench``: the benchmark runner (``python3 -m kage.bench run|report|score|status|slurm|speed``).
 
@@ -21,6 +22,7 @@ _LAZY = {
     "Diagnostic": "kage.errors",
     "DeviceUnavailableError": "kage.errors",
     "INFO_FIELDS": "kage.vector",
+    "compile_kernels": "kage.kernels",
     "VecEnv": "kage.vector",
     "env_seeds": "kage.vector",
     "make_vec": "kage.vector",

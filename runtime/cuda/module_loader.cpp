@@ -194,9 +194,7 @@ std::optional<CudaModule> CudaModule::load_file(const std::string& path, std::st
   return m;
 }
 
-std::optional<std::string> cubin_for(const std::string& source, const std::string& name, const NvrtcOptions& options,
-                                     std::string* error, bool* cache_hit, bool read_cache) {
-  if (cache_hit) *cache_hit = false;
+std::optional<std::string> device_arch(std::string* error) {
   if (!cuda_primary_context(error)) return std::nullopt;
   CUdevice dev;
   int major = 0, minor = 0;
@@ -207,7 +205,21 @@ std::optional<std::string> cubin_for(const std::string& source, const std::strin
     *error = cu_error_text(r, "cuDeviceGetAttribute");
     return std::nullopt;
   }
-  const std::string arch = "sm_" + std::to_string(major) + std::to_string(minor);
+  return "sm_" + std::to_string(major) + std::to_string(minor);
+}
+
+std::optional<std::string> cubin_for(const std::string& source, const std::string& name, const NvrtcOptions& options,
+                                     std::string* error, bool* cache_hit, bool read_cache) {
+  if (cache_hit) *cache_hit = false;
+  const std::optional<std::string> arch = device_arch(error);
+  if (!arch) return std::nullopt;
+  return cubin_for_arch(source, name, options, *arch, error, cache_hit, read_cache);
+}
+
+std::optional<std::string> cubin_for_arch(const std::string& source, const std::string& name,
+                                          const NvrtcOptions& options, const std::string& arch, std::string* error,
+                                          bool* cache_hit, bool read_cache) {
+  if (cache_hit) *cache_hit = false;
   const std::vector<std::string> opts = nvrtc_option_list(arch, options);
 
   int nv_major = 0, nv_minor = 0;

@@ -36,6 +36,16 @@ std::vector<std::string> nvrtc_option_list(const std::string& arch, const NvrtcO
 std::optional<std::string> nvrtc_compile(const std::string& source, const std::string& name,
                                          const std::vector<std::string>& options, std::string* error);
 
+/// The architecture of the current device ("sm_90"); nullopt with a message when there is no driver or
+/// no device.
+std::optional<std::string> device_arch(std::string* error);
+
+/// The cubin of `source` for `arch`: from the cache, or compiled with NVRTC and stored there. Needs no
+/// driver and no GPU. Thread-safe. `cache_hit` and `read_cache` as for cubin_for.
+std::optional<std::string> cubin_for_arch(const std::string& source, const std::string& name,
+                                          const NvrtcOptions& options, const std::string& arch, std::string* error,
+                                          bool* cache_hit = nullptr, bool read_cache = true);
+
 /// The cubin of `source` for the current device: from the cache, or compiled with NVRTC and stored
 /// there. Thread-safe (each call makes the primary context current on its thread), so several
 /// configs can compile at once. `cache_hit`, if given, tells which happened; `read_cache` false

@@ -143,9 +143,21 @@ def open_env(config: str, num_envs: int, spec: dict, file: str, options) -> "kag
     return env
 
 
+def compile_ahead(options) -> None:
+    """The configs' GPU kernels compiled side by side (kage.compile_kernels) before their batches open one by one."""
+    try:
+        kage.compile_kernels(options.config, asset_root=options.asset_root)
+    except ConfigError as e:
+        fail(f"{e}\nkage.ppo.evaluate: a config has the errors above: fix the config first")
+    except (ValueError, RuntimeError, OSError) as e:  # no GPU, not a config, NVRTC's log
+        fail(f"compiling the kernels of the configs: {e}")
+
+
 def evaluate_configs(agent, spec: dict, file: str, state: dict, options) -> List[dict]:
     """--config: each config's results (§3.2), one evaluation for all of them together; the i-th config takes
     the i-th eval config's seed."""
+    if options.device == "cuda" and len(options.config) > 1:
+        compile_ahead(options)
     envs = [open_env(c, options.num_envs, spec, file, options) for c in options.config]
     seeds = [evaluation_seed(options.seed, i + 1, state["iteration"]) for i in range(len(envs))]
     results = evaluate(agent, [envs], [seeds], settings_of(spec, options))[0]

@@ -1,6 +1,8 @@
 """The runs of a pack: what each owns besides its slice of the network (its arguments, Specs, stages, batches, the
 CUDA stream of its batches and its directory), how its batches are made for a stage and replaced at a stage
 boundary, and the device views of the training batches' outputs that the loop reads every step."""
+import sys
+import time
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
@@ -27,6 +29,22 @@ class Run:
     stage: int = 0
     dir: Optional[rundir.RunDir] = None  # opened once everything that can be refused was checked
     history: List[dict] = field(default_factory=list)
+
+
+def compile_kernels(pack: List[Args]) -> None:
+    """The GPU kernels of every config of the pack's runs compiled side by side, before any batch opens (each batch
+    would otherwise compile its config as it opens, one config after another, tens of seconds each); says what it
+    did and how long it took."""
+    configs = list(dict.fromkeys(path for args in pack for _, path in configs_of(args)))
+    started = time.perf_counter()
+    try:
+        done = kage.compile_kernels(configs, asset_root=pack[0].asset_root)
+    except ConfigError as e:
+        raise SystemExit(f"{e}\nkage.ppo.train: a config has the errors above: fix the config first") from None
+    except (ValueError, RuntimeError, OSError) as e:  # no GPU, not a config, NVRTC's log
+        raise SystemExit(f"kage.ppo.train: compiling the kernels of {len(configs)} configs: {e}") from None
+    print(f"kage.ppo.train: the kernels of {len(configs)} configs: {done['compiled']} compiled, {done['cached']} "
+          f"from the cache, in {time.perf_counter() - started:.1f} s", file=sys.stderr)
 
 
 def open_batches(args: Args, threads: int) -> Run:

@@ -61,7 +61,7 @@ from kage.ppo.loop_state import LoopState, resume, save_checkpoints
 from kage.ppo.losses import (clip_grad_norm_per_run, compute_gae, drac_regularisers, entropy_coefficient, entropy_of,
                              ppo_loss)
 from kage.ppo.policy import RolloutPolicy, autocast
-from kage.ppo.runs import BatchViews, Run, enter_stage, open_batches, open_run_dir
+from kage.ppo.runs import BatchViews, Run, compile_kernels, enter_stage, open_batches, open_run_dir
 from kage.ppo.wrappers import FrameStack, RewardNormalizer
 from kage.util.files import os_error_text, safe
 from kage.util.stop import StopRequest, die_with_parent
@@ -94,9 +94,11 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     # (their size against the memory), the agent and the augmentation (each called once on blank frames), and
     # the rollout's storage against the device's free memory.
     opening = time.perf_counter()
+    if device.type == "cuda":
+        compile_kernels(pack)
     runs = [open_batches(a, threads) for a in pack]
     K, T, N = len(runs), args.num_steps, args.num_envs
-    # A pack's start can take minutes (a batch per run and config): the log says how long, for the lease plans.
+    # A pack's start takes a while (its configs' kernels, then a batch per run and config): the log says how long.
     print(f"kage.ppo.train: {sum(1 + len(run.eval_envs) for run in runs)} batches of {K} runs opened in "
           f"{time.perf_counter() - opening:.1f} s", file=sys.stderr)
     height, width, channels = runs[0].env.single_observation_space.shape
