@@ -601,8 +601,9 @@ std::optional<KernelsCompiled> compile_kernels(const std::vector<std::string>& p
   ErrorKind ignored = ErrorKind::kOther;
   ErrorKind* kind = kind_out ? kind_out : &ignored;
 #if !defined(KAGE_API_HAVE_CUDA)
-  (void)paths;
-  (void)o;
+  for (const std::string& path : paths)  // a config's errors first, as with the GPU backend
+    if (!load_yaml(path, o, error)) return *kind = ErrorKind::kConfig, std::nullopt;
+  if (paths.empty()) return *kind = ErrorKind::kNone, KernelsCompiled{};
   *kind = ErrorKind::kDevice;
   fail(error, "kage::compile_kernels: GPU backend not built (no CUDA toolkit at build time)");
   return std::nullopt;

@@ -2,8 +2,8 @@
 # The CPU-only build (KAGE_CUDA=OFF), which AUTO never makes on a machine with nvcc and NVRTC: kagec and
 # the Python package built into build-cpu-only (only the targets the checks need; ccache supplies the
 # objects that do not differ from build/'s), then a compile with its kagec and the Python tests of what
-# KAGE_CUDA changes: the extension (the environment API, its arrays, threads, errors and resources, the
-# Gymnasium and JAX bindings) and a short training run. The rest of the Python side is the same code on
+# KAGE_CUDA changes: the extension (the environment API, its arrays, threads, errors, resources and
+# compile_kernels, the Gymnasium and JAX bindings) and a short training run. The rest of the Python side is the same code on
 # either build and runs in scripts/test.sh. Run after scripts/build.sh, whose .venv it uses.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,5 +24,5 @@ PYTHONPATH=$build/python "$python" -c 'import kage, sys; sys.exit(kage.gpu_backe
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$build/kagec" compile configs/throughput/simplest.yaml -o "$work/compiled" --no-gpu
-native='vec_api|zero_copy|errors|env_checks|gymnasium|array_layout|threads|autoreset|resources|jax_env|same_bytes'
+native='vec_api|zero_copy|errors|compile_kernels|env_checks|gymnasium|array_layout|threads|autoreset|resources|jax_env|same_bytes'
 ctest --test-dir "$build" --output-on-failure -j"$(nproc)" -R "^python/test_($native|state|train_options)(::|\$)"

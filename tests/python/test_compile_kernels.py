@@ -65,5 +65,5 @@ def test_the_trainer_names_a_config_with_errors_and_the_fix():
 @pytest.mark.skipif(has_cuda_driver(), reason="reported skip: this machine has a CUDA driver (tests/gpu compiles)")
 def test_the_trainer_counts_each_config_of_its_pack_once():
     from kage.ppo import runs
-    with pytest.raises(SystemExit, match="compiling the kernels of 2 configs: .*no usable"):
+    with pytest.raises(SystemExit, match=r"(?s)compiling the kernels of 2 configs: .*no usable"):
         runs.compile_kernels(pack_of(str(CONFIGS / "near_goal.yaml")))
