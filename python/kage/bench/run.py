@@ -1,5 +1,5 @@
 """python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [--pack K] [--share-training]
-[--task I | --gpus all|0,2 [--tasks 0,3]] [trainer flags]
+[--task I | --gpus all|0,2 [--tasks 0,3]] [--dry-run] [trainer flags]
 
 Trains every (pair, seed) of a suite manifest with `python3 -m kage.ppo.train`, each run in its own run
 directory, one process after the other; --pack K trains K runs at once in one process (one GPU), which
@@ -8,6 +8,7 @@ task table (kage.bench.tasks): --task I trains task I alone (a Slurm array task,
 --gpus keeps one worker per GPU busy with the tasks (kage.bench.gpus). An --agent that cannot be
 packed trains its runs one at a time. --share-training trains pairs that share a train config once per
 seed, in one run that evaluates all their eval configs (the 34 pairs of KAGE-Bench have 7 train configs).
+--dry-run prints the task table, and with --gpus each GPU's tasks, and trains and writes nothing.
 
     DIR/suite.json                  the suite's report (kagec suite): pairs, axes, paths, spec hashes, certificates
     DIR/bench.json                  the manifest, the seeds asked for so far, the trainer flags and the shared runs
@@ -39,7 +40,7 @@ from typing import Dict, List, Optional
 
 from kage import front_end, resources
 from kage.ppo import plugins
-from kage.bench import gpus, run_state, tasks
+from kage.bench import dry_run, gpus, run_state, tasks
 from kage.bench.records import bench_problem, parse_seeds, suite_problem, unit_name_problem
 from kage.bench.units import Unit, select, train_stem, training_configs, units_of
 from kage.errors import ConfigError
@@ -471,6 +472,8 @@ def main(argv: List[str]) -> int:
                                        "tasks until none is left")
     parser.add_argument("--tasks", help="with --gpus: only these tasks of DIR/tasks.json, a list like 0,3,4 (what "
                                         "fits a lease)")
+    parser.add_argument("--dry-run", action="store_true",
+                        help="print the task table (and, with --gpus, each GPU's tasks) without training or writing")
     args, trainer_args = parser.parse_known_args(argv)
     die_with_parent()  # a --task worker of --gpus stops with its runner
     try:
@@ -487,6 +490,12 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
         raise SystemExit("kage.bench run: --tasks picks the tasks that --gpus trains: add --gpus all (or use --task I "
                          "for one task in this process)")
     bench = plan(args, trainer_args)
+    if args.dry_run:
+        if args.task is not None:
+            raise SystemExit("kage.bench run: --dry-run shows every task: drop --task")
+        only = dry_run.tasks_of(args.tasks, bench.table())
+        print(dry_run.describe(bench, dry_run.worker_count(args.gpus) if args.gpus else None, only))
+        return 0
     if bench.device == "cuda":
         import torch  # here: kage.bench slurm plans on machines without torch's GPU build
         if not torch.cuda.is_available():  # every run would fail alone, each in its own train.log

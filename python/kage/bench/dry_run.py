@@ -1,0 +1,65 @@
+"""kage.bench run --dry-run: the task table a benchmark would train, and how --gpus would share it, without
+training or writing anything: for choosing --pack and --tasks so that a lease's GPUs end together."""
+import heapq
+from typing import List, Optional
+
+from kage.bench import gpus, tasks
+
+
+def schedule(weights: List[int], workers: int) -> List[List[int]]:
+    """The tasks (indices into `weights`, handed out in that order) each of `workers` workers takes when each takes
+    the next as it comes free, a task of weight w lasting w: as run_on_gpus hands them out."""
+    free = [(0, worker) for worker in range(workers)]
+    taken: List[List[int]] = [[] for _ in range(workers)]
+    for index, weight in enumerate(weights):
+        load, worker = heapq.heappop(free)
+        taken[worker].append(index)
+        heapq.heappush(free, (load + weight, worker))
+    return taken
+
+
+def describe(bench, workers: Optional[int], only: Optional[List[int]]) -> str:
+    """The task table of `bench`, then, for `workers` GPUs, the tasks each would train (longest first) and its
+    share of the busiest GPU's work."""
+    table = bench.table()
+    lines = [f"kage.bench run --dry-run: {len(table)} tasks, {sum(map(len, table))} runs (--pack {bench.pack}"
+             f"{', --share-training' if bench.share_training else ''}); nothing trained or written"]
+    for i, task in enumerate(table):
+        units = sorted({unit.name for unit, _, _ in task})
+        configs = 1 + len(task[0][0].evals)
+        lines.append(f"task {i}: {plural(len(task), 'run')} x {configs} configs, weight {gpus.task_weight(task)}: "
+                     f"{', '.join(units)}")
+    if workers:
+        order = gpus.longest_first(table, only if only is not None else list(range(len(table))))
+        taken = schedule([gpus.task_weight(table[i]) for i in order], workers)
+        loads = [sum(gpus.task_weight(table[order[j]]) for j in worker) for worker in taken]
+        busiest = max(loads) or 1
+        lines.append(f"on {workers} GPUs, longest first (weight: a run's evaluation of one config, a run's "
+                     f"training counting {gpus.TRAINING_AS_CONFIGS}):")
+        for g, (worker, load) in enumerate(zip(taken, loads)):
+            names = f"{'task' if len(worker) == 1 else 'tasks'} {', '.join(str(order[j]) for j in worker)}"
+            lines.append(f"  GPU {g}: {names if worker else 'no task'}, weight {load} "
+                         f"({100 * load / busiest:.0f} % of the busiest)")
+    return "\n".join(lines)
+
+
+def plural(count: int, noun: str) -> str:
+    return f"{count} {noun}{'' if count == 1 else 's'}"
+
+
+def worker_count(text: str) -> int:
+    """--gpus for a dry run: a list's length, or 'all': this machine's GPUs (none needed for a list)."""
+    if text == "all":
+        count = gpus.device_count()
+        if count == 0:
+            raise SystemExit("kage.bench run --dry-run: --gpus all, but torch sees no CUDA GPU here: give the lease's "
+                             "GPUs as a list, e.g. --gpus 0,1,2,3")
+        return count
+    return len(gpus.index_list("--gpus", text, 1 << 16, "use 'all' or GPU indices like 0,2", "indices are"))
+
+
+def tasks_of(text: Optional[str], table: List[List[tasks.Job]]) -> Optional[List[int]]:
+    """--tasks for a dry run: checked against the table, as the runner checks them."""
+    if text is None:
+        return None
+    return gpus.index_list("--tasks", text, len(table), "a list like 0,3,4", "the task table's indices are")

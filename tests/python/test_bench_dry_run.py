@@ -1,0 +1,65 @@
+"""kage.bench run --dry-run: the task table and each GPU's tasks, with nothing trained or written. The expected
+tables are derived from the suite by hand: under --share-training KAGE-Bench's 34 pairs train 9 runs a seed, two
+evaluating 10 eval configs (image_skeleton's filters and background/9; shape_black's background, agent and
+distractors pairs), five evaluating 1 (background/4, /6, /7, /10 and layout/1), one 6 and one 3."""
+import re
+
+import pytest
+
+from kage.bench import dry_run, gpus, run
+
+
+def dry(capsys, *extra):
+    status = run.main(["kage_bench", "--seeds", "1-5", "--share-training", "--out", "never-made", "--dry-run",
+                       *extra])
+    return status, capsys.readouterr().out
+
+
+def test_the_table_and_the_gpus_tasks_with_nothing_written(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    status, out = dry(capsys, "--pack", "12", "--gpus", "0,1,2,3")
+    assert status == 0
+    assert not (tmp_path / "never-made").exists()
+    lines = out.splitlines()
+    assert lines[0].startswith("kage.bench run --dry-run: 6 tasks, 45 runs (--pack 12, --share-training)")
+    # 10 runs of 11 configs; the 25 runs of 2 configs in packs of 12; then the 6-eval and the 3-eval units.
+    assert [line.split(":")[0] + ": " + line.split(": ")[1].split(",")[0] for line in lines[1:7]] == [
+        "task 0: 10 runs x 11 configs", "task 1: 12 runs x 2 configs", "task 2: 12 runs x 2 configs",
+        "task 3: 1 run x 2 configs", "task 4: 5 runs x 7 configs", "task 5: 5 runs x 4 configs"]
+    gpu_lines = [line for line in lines if line.startswith("  GPU ")]
+    assert len(gpu_lines) == 4
+    taken = [re.match(r"  GPU \d: tasks? ([\d, ]+), weight", line).group(1).split(", ") for line in gpu_lines]
+    assert sorted(int(task) for tasks in taken for task in tasks) == [0, 1, 2, 3, 4, 5]  # each task once
+    assert taken[0] == ["0"]  # the heaviest (10 runs of 11 configs) first, alone on its GPU
+
+
+def test_only_the_tasks_named(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    status, out = dry(capsys, "--pack", "12", "--gpus", "0,1", "--tasks", "4,5")
+    assert status == 0
+    gpu_lines = [line for line in out.splitlines() if line.startswith("  GPU ")]
+    assert gpu_lines[0].startswith("  GPU 0: task 4, weight 85") and gpu_lines[1].startswith("  GPU 1: task 5, ")
+
+
+def test_schedule_hands_each_task_to_the_first_free_worker():
+    # Worker 0 takes 5 and worker 1 takes 4; worker 1 (free at 4) takes 3 (to 7); worker 0 (free at 5) takes 3
+    # (to 8); worker 1 (free at 7) takes 2.
+    assert dry_run.schedule([5, 4, 3, 3, 2], 2) == [[0, 3], [1, 2, 4]]
+    assert dry_run.schedule([1], 3) == [[0], [], []]
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--task", "0"], "--dry-run shows every task: drop --task"),
+    (["--gpus", "0,1", "--tasks", "99"], "--tasks 99"),
+])
+def test_refusals(capsys, tmp_path, monkeypatch, extra, message):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit, match=message):
+        dry(capsys, *extra)
+
+
+def test_all_gpus_without_a_gpu_asks_for_a_list(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(gpus, "device_count", lambda: 0)
+    with pytest.raises(SystemExit, match="give the lease's GPUs as a list, e.g. --gpus 0,1,2,3"):
+        dry(capsys, "--gpus", "all")
