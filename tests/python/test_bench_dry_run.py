@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from kage.bench import dry_run, gpus, run
+from kage.bench import gpus, run
 
 
 def dry(capsys, *extra):
@@ -41,11 +41,12 @@ def test_only_the_tasks_named(capsys, tmp_path, monkeypatch):
     assert gpu_lines[0].startswith("  GPU 0: task 4, weight 85") and gpu_lines[1].startswith("  GPU 1: task 5, ")
 
 
-def test_schedule_hands_each_task_to_the_first_free_worker():
+def test_hand_out_gives_each_task_to_the_first_free_worker():
     # Worker 0 takes 5 and worker 1 takes 4; worker 1 (free at 4) takes 3 (to 7); worker 0 (free at 5) takes 3
-    # (to 8); worker 1 (free at 7) takes 2.
-    assert dry_run.schedule([5, 4, 3, 3, 2], 2) == [[0, 3], [1, 2, 4]]
-    assert dry_run.schedule([1], 3) == [[0], [], []]
+    # (to 8); worker 1 (free at 7) takes 2 (to 9).
+    assert gpus.hand_out([5, 4, 3, 3, 2], [0, 0]) == ([[0, 3], [1, 2, 4]], [8, 9])
+    assert gpus.hand_out([1], [0, 0, 0]) == ([[0], [], []], [1, 0, 0])
+    assert gpus.hand_out([2], [3, 1]) == ([[], [0]], [3, 3])  # the worker free first takes it
 
 
 @pytest.mark.parametrize("extra, message", [

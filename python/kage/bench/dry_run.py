@@ -1,21 +1,8 @@
 """kage.bench run --dry-run: the task table a benchmark would train, and how --gpus would share it, without
 training or writing anything: for choosing --pack and --tasks so that a lease's GPUs end together."""
-import heapq
 from typing import List, Optional
 
 from kage.bench import gpus, tasks
-
-
-def schedule(weights: List[int], workers: int) -> List[List[int]]:
-    """The tasks (indices into `weights`, handed out in that order) each of `workers` workers takes when each takes
-    the next as it comes free, a task of weight w lasting w: as run_on_gpus hands them out."""
-    free = [(0, worker) for worker in range(workers)]
-    taken: List[List[int]] = [[] for _ in range(workers)]
-    for index, weight in enumerate(weights):
-        load, worker = heapq.heappop(free)
-        taken[worker].append(index)
-        heapq.heappush(free, (load + weight, worker))
-    return taken
 
 
 def describe(bench, workers: Optional[int], only: Optional[List[int]]) -> str:
@@ -31,8 +18,7 @@ def describe(bench, workers: Optional[int], only: Optional[List[int]]) -> str:
                      f"{', '.join(units)}")
     if workers:
         order = gpus.longest_first(table, only if only is not None else list(range(len(table))))
-        taken = schedule([gpus.task_weight(table[i]) for i in order], workers)
-        loads = [sum(gpus.task_weight(table[order[j]]) for j in worker) for worker in taken]
+        taken, loads = gpus.hand_out([gpus.task_weight(table[i]) for i in order], [0] * workers)
         busiest = max(loads) or 1
         lines.append(f"on {workers} GPUs, longest first (weight: a run's evaluation of one config, a run's "
                      f"training counting {gpus.TRAINING_AS_CONFIGS}):")

@@ -13,7 +13,7 @@ import subprocess
 import sys
 import threading
 import time
-from typing import List, Optional
+from typing import List, Optional, Tuple
 
 from kage.bench import tasks
 from kage.util.stop import child_environment, stop_children
@@ -64,16 +64,29 @@ def longest_first(table: List[List[tasks.Job]], indices: List[int]) -> List[int]
     return sorted(indices, key=lambda i: -task_weight(table[i]))
 
 
+def hand_out(durations: List[float], free_at: List[float]) -> Tuple[List[List[int]], List[float]]:
+    """The waiting tasks (their durations, in the order they are handed out) each taken by the first worker to come
+    free (workers free at `free_at`; ties to the lowest index), as run_on_gpus does: each worker's task indices,
+    and when it ends."""
+    free = [(at, worker) for worker, at in enumerate(free_at)]
+    heapq.heapify(free)
+    taken: List[List[int]] = [[] for _ in free_at]
+    ends = list(free_at)
+    for index, duration in enumerate(durations):
+        at, worker = heapq.heappop(free)
+        taken[worker].append(index)
+        ends[worker] = at + duration
+        heapq.heappush(free, (ends[worker], worker))
+    return taken, ends
+
+
 def eta_seconds(unit_seconds: float, waiting: List[int], running: List[tuple], workers: int) -> float:
     """Seconds until the last task ends if a task of weight w takes w * unit_seconds: the running tasks ((weight,
     seconds elapsed) each) end first, and the workers take the waiting tasks (their weights, in the order they are
-    handed out) as they come free, as run_on_gpus does."""
+    handed out) as they come free."""
     free = [max(weight * unit_seconds - elapsed, 0.0) for weight, elapsed in running]
     free += [0.0] * (workers - len(free))
-    heapq.heapify(free)
-    for weight in waiting:
-        heapq.heapreplace(free, free[0] + weight * unit_seconds)
-    return max(free)
+    return max(hand_out([weight * unit_seconds for weight in waiting], free)[1])
 
 
 def parse_tasks(text: Optional[str], count: int, out: str) -> Optional[List[int]]:
