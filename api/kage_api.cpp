@@ -20,7 +20,7 @@
 #include "runtime/cpu/host_batch.h"
 #include "runtime/io/asset_pack.h"
 #if defined(KAGE_API_HAVE_CUDA)
-#include "compiler/codegen/build.h"
+#include "compiler/codegen/nvrtc_options.h"
 #include "runtime/cuda/device_batch.h"
 #include "runtime/cuda/parallel_compile.h"
 #endif
@@ -356,24 +356,12 @@ class GpuEnv final : public Env {
   std::vector<int32_t> actions_;
 };
 
-/// NVRTC's options for a config's generated source: the runtime headers beside the package, the generator's
-/// version (both in the kernel cache's key).
-NvrtcOptions loader_options() {
-  NvrtcOptions no;
-  no.include_dir = runtime_include_dir();
-  no.generator_version = std::to_string(kCodegenVersion);
-  return no;
-}
-
-/// The name of a config's generated source in NVRTC's diagnostics.
-std::string source_name(const std::string& spec_hash) { return "kage_" + spec_hash.substr(0, 16) + ".cu"; }
-
 /// The module of one config: its fatbin when given, else NVRTC on its generated `source` (through the
 /// kernel cache). Each call loads a module of its own, with its own __constant__ parameters.
 std::optional<CudaModule> gpu_module(const std::string& spec_hash, const std::string& source, const std::string& fatbin,
                                      std::string* error) {
   if (!fatbin.empty()) return CudaModule::load_file(fatbin, error);
-  return CudaModule::compile(source, source_name(spec_hash), loader_options(), error);
+  return CudaModule::compile(source, "kage_" + spec_hash.substr(0, 16) + ".cu", generated_source_options(), error);
 }
 
 /// One config of a GPU batch: its Spec hash and lowered parameters, its generated source (or fatbin path),
@@ -615,16 +603,17 @@ std::optional<KernelsCompiled> compile_kernels(const std::vector<std::string>& p
     std::optional<Loaded> l = load_yaml(path, o, error);
     if (!l) return *kind = ErrorKind::kConfig, std::nullopt;
     if (!seen.insert(l->spec_hash).second) continue;
+    GeneratedSource generated = generate_source({l->spec_hash, l->config.latent, l->config.visual});
     KernelJob job;
-    job.source = generate_source({l->spec_hash, l->config.latent, l->config.visual}).text;
-    job.name = source_name(l->spec_hash);
+    job.source = std::move(generated.text);
+    job.name = std::move(generated.file_name);
     jobs.push_back(std::move(job));
     job_paths.push_back(path);
   }
   if (jobs.empty()) return *kind = ErrorKind::kNone, KernelsCompiled{};
   const std::optional<std::string> arch = device_arch(error);
   if (!arch) return *kind = ErrorKind::kDevice, std::nullopt;
-  compile_jobs(jobs, loader_options(), *arch, compile_threads(jobs.size()));
+  compile_jobs(jobs, generated_source_options(), *arch, compile_threads(jobs.size()));
   KernelsCompiled done;
   for (size_t i = 0; i < jobs.size(); ++i) {
     if (!jobs[i].cubin) {

@@ -13,6 +13,7 @@
 #include "compiler/analysis/suite.h"
 #include "compiler/codegen/build.h"
 #include "compiler/codegen/codegen.h"
+#include "compiler/codegen/nvrtc_options.h"
 #include "driver/cmd_bench_gpu.h"
 #include "compiler/lower/lower.h"
 #include "runtime/io/asset_pack.h"
@@ -108,12 +109,9 @@ std::optional<Job> make_job(const std::string& label, const Spec& spec, std::str
 /// Fills every job's cubin for `arch`, from the kernel cache or NVRTC, configs side by side; one line on
 /// `progress` per finished config.
 void compile_all(std::vector<Job>& jobs, const std::string& arch, std::ostream& progress) {
-  NvrtcOptions no;
-  no.include_dir = runtime_include_dir();
-  no.generator_version = std::to_string(kCodegenVersion);
   std::vector<KernelJob> kernels;
   for (Job& j : jobs) kernels.push_back(std::move(j.kernels));
-  compile_jobs(kernels, no, arch, compile_threads(kernels.size()), [&](const KernelJob& k, size_t done) {
+  compile_jobs(kernels, generated_source_options(), arch, compile_threads(kernels.size()), [&](const KernelJob& k, size_t done) {
     progress << "kagec bench: config " << done << " of " << jobs.size() << ", "
              << jobs[static_cast<size_t>(&k - kernels.data())].label << ": "
              << (!k.cubin ? "FAILED" : k.cached ? "cached" : "compiled in " + fixed(k.seconds, 1) + " s") << '\n'

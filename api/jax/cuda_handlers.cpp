@@ -17,9 +17,9 @@
 
 #include "api/jax/ffi_buffers.h"
 #include "api/jax/ffi_handlers.h"
-#include "compiler/codegen/build.h"
 #include "compiler/codegen/codegen.h"
 #include "compiler/codegen/compiled_dir.h"
+#include "compiler/codegen/nvrtc_options.h"
 #include "runtime/cuda/device_batch.h"
 #include "runtime/cuda/device_envs.h"
 #include "runtime/cuda/module_loader.h"
@@ -58,10 +58,7 @@ std::optional<CudaModule> load_module(const JaxConfig& c, std::string* error) {
   } else {
     source = generate_source({c.spec_hash, c.latent, c.visual}).text;
   }
-  NvrtcOptions options;
-  options.include_dir = runtime_include_dir();
-  options.generator_version = std::to_string(kCodegenVersion);
-  return CudaModule::compile(source, "kage_" + c.spec_hash.substr(0, 16) + ".cu", options, error);
+  return CudaModule::compile(source, "kage_" + c.spec_hash.substr(0, 16) + ".cu", generated_source_options(), error);
 }
 
 bool check(CUresult r, const char* what, std::string* error) {
