@@ -139,7 +139,7 @@ DeviceEnvs device_envs(const JaxConfig& c, const DeviceProgram& p, const EnvBuff
   e.segments = b.segments;
   e.visual = b.visual;
   // No error report: the Python side records out-of-range actions in the state; the kernel masks them.
-  e.actions = ActionSource{b.actions, 1, 0, 0, nullptr};
+  e.actions = ActionSource{b.actions, 1, 0, nullptr, nullptr};
   e.obs = b.obs;
   e.reward = b.reward;
   e.terminated = b.terminated;

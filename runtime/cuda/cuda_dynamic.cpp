@@ -84,6 +84,8 @@ KAGE_CU_FORWARD(cuMemcpy2DAsync, (const CUDA_MEMCPY2D* c, CUstream s), (c, s))
 KAGE_CU_FORWARD(cuMemHostAlloc, (void** p, size_t bytes, unsigned int flags), (p, bytes, flags))
 KAGE_CU_FORWARD(cuMemHostGetDevicePointer, (CUdeviceptr * d, void* p, unsigned int flags), (d, p, flags))
 KAGE_CU_FORWARD(cuMemFreeHost, (void* p), (p))
+KAGE_CU_FORWARD(cuStreamCreate, (CUstream * s, unsigned int flags), (s, flags))
+KAGE_CU_FORWARD(cuStreamDestroy, (CUstream s), (s))
 KAGE_CU_FORWARD(cuStreamSynchronize, (CUstream s), (s))
 KAGE_CU_FORWARD(cuStreamWaitEvent, (CUstream s, CUevent e, unsigned int flags), (s, e, flags))
 KAGE_CU_FORWARD(cuLaunchKernel,

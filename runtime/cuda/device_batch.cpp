@@ -295,6 +295,10 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
   if (!check(cuMemAlloc(&b.state_, l.total), "cuMemAlloc(state)", error)) return std::nullopt;
   if (!check(cuMemsetD8(b.state_, 0, l.total), "cuMemsetD8(state)", error)) return std::nullopt;
   if (!check(cuMemAlloc(&b.obs_buf_, 2 * n * b.obs_stride_), "cuMemAlloc(observations)", error)) return std::nullopt;
+  const size_t count_bytes = parts.size() * sizeof(StepCount);
+  if (!check(cuMemAlloc(&b.step_counts_, count_bytes), "cuMemAlloc(step counts)", error) ||
+      !check(cuMemsetD8(b.step_counts_, 0, count_bytes), "cuMemsetD8(step counts)", error))
+    return std::nullopt;
   // One host-mapped report slot per part: a part's kernels number its environments from 0.
   void* mapped = nullptr;
   CUdeviceptr mapped_device = 0;
@@ -313,7 +317,8 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
   e.latent = reinterpret_cast<LatentState*>(ptr(l.latent));
   e.segments = ptr(l.segments);
   e.visual = reinterpret_cast<VisualState*>(ptr(l.visual));
-  e.actions = ActionSource{ptr(l.actions), 1, 0, 0, reinterpret_cast<ActionError*>(mapped_device)};
+  e.actions = ActionSource{ptr(l.actions), 1, 0, reinterpret_cast<StepCount*>(b.step_counts_),
+                           reinterpret_cast<ActionError*>(mapped_device)};
   e.reset_mask = nullptr;
   e.obs = reinterpret_cast<uint8_t*>(b.obs_buf_);
   e.reward = reinterpret_cast<float*>(ptr(l.reward));
@@ -335,10 +340,21 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
     p.envs.assets = assets;
     p.envs.visual_extent = extent;
     p.envs.actions.error = reinterpret_cast<ActionError*>(mapped_device) + k;
+    p.envs.actions.count = reinterpret_cast<StepCount*>(b.step_counts_) + k;
   }
   b.reset_mask_ = ptr(l.reset_mask);
   b.seeds_.assign(n, 0);
+  if (b.parts_.size() > 1 && !b.create_part_streams(error)) return std::nullopt;
   return b;
+}
+
+bool DeviceBatch::create_part_streams(std::string* error) {
+  if (!check(cuEventCreate(&fork_, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error)) return false;
+  for (Part& p : parts_)
+    if (!check(cuStreamCreate(&p.stream, CU_STREAM_NON_BLOCKING), "cuStreamCreate", error) ||
+        !check(cuEventCreate(&p.stepped, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error))
+      return false;
+  return true;
 }
 
 DeviceBatch::DeviceBatch(DeviceBatch&& o) noexcept
@@ -347,48 +363,54 @@ DeviceBatch::DeviceBatch(DeviceBatch&& o) noexcept
       stream_(o.stream_),
       obs_stride_(o.obs_stride_),
       segment_count_(o.segment_count_),
-      steps_(o.steps_),
       state_(o.state_),
       obs_buf_(o.obs_buf_),
+      step_counts_(o.step_counts_),
       reset_mask_(o.reset_mask_),
       seeds_(std::move(o.seeds_)),
       action_error_(o.action_error_),
-      sample_actions_(o.sample_actions_) {
+      sample_actions_(o.sample_actions_),
+      fork_(o.fork_) {
   o.parts_.clear();
-  o.state_ = o.obs_buf_ = 0;
+  o.state_ = o.obs_buf_ = o.step_counts_ = 0;
   o.action_error_ = nullptr;
+  o.fork_ = nullptr;
 }
 
 DeviceBatch::~DeviceBatch() {
   // Frees fail only once the context is gone at exit, when the memory is released anyway.
-  for (CUdeviceptr p : {state_, obs_buf_})
+  for (CUdeviceptr p : {state_, obs_buf_, step_counts_})
     if (p) cuMemFree(p);
-  for (const Part& p : parts_)
+  for (const Part& p : parts_) {
     if (p.assets) cuMemFree(p.assets);
+    if (p.stepped) cuEventDestroy(p.stepped);
+    if (p.stream) cuStreamDestroy(p.stream);
+  }
+  if (fork_) cuEventDestroy(fork_);
   if (action_error_) cuMemFreeHost(action_error_);
 }
 
-bool DeviceBatch::launch_per_env(CUfunction f, const DeviceEnvs& envs, std::string* error) {
+bool DeviceBatch::launch_per_env(CUfunction f, const DeviceEnvs& envs, CUstream stream, std::string* error) {
   if (envs.num_envs == 0) return true;  // a mixture's part of no environments
   DeviceEnvs arg = envs;
   void* args[] = {&arg};
   const unsigned grid = static_cast<unsigned>((envs.num_envs + kPerEnvThreads - 1) / kPerEnvThreads);
-  return check(cuLaunchKernel(f, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream_, args, nullptr), "cuLaunchKernel", error);
+  return check(cuLaunchKernel(f, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream, args, nullptr), "cuLaunchKernel", error);
 }
 
-bool DeviceBatch::launch_render(const Part& p, std::string* error) {
+bool DeviceBatch::launch_render(const Part& p, CUstream stream, std::string* error) {
   if (p.envs.num_envs == 0) return true;
   DeviceEnvs arg = p.envs;
   void* args[] = {&arg};
   const unsigned grid = static_cast<unsigned>((p.envs.num_envs + p.frames_per_block - 1) / p.frames_per_block);
   return check(cuLaunchKernel(p.render, grid, 1, 1, static_cast<unsigned>(p.render_threads),
-                              1, 1, static_cast<unsigned>(p.render_smem), stream_, args, nullptr),
+                              1, 1, static_cast<unsigned>(p.render_smem), stream, args, nullptr),
                "cuLaunchKernel", error);
 }
 
 bool DeviceBatch::launch_renders(std::string* error) {
   for (const Part& p : parts_)
-    if (!launch_render(p, error)) return false;
+    if (!launch_render(p, stream_, error)) return false;
   return true;
 }
 
@@ -406,23 +428,32 @@ bool DeviceBatch::reset(const uint64_t* seeds, const uint8_t* mask, std::string*
   for (const Part& p : parts_) {
     DeviceEnvs v = p.envs;
     v.reset_mask = mask ? reset_mask_ + p.first : nullptr;
-    if (!launch_per_env(p.reset, v, error)) return false;
+    if (!launch_per_env(p.reset, v, stream_, error)) return false;
   }
   return launch_renders(error);
 }
 
 bool DeviceBatch::launch_step(const ActionSource& source, bool render, std::string* error) {
-  const uint64_t step = ++steps_;
   const int64_t element = source.is_int64 ? sizeof(int64_t) : sizeof(int32_t);
+  // One part steps on stream_; a mixture's parts each on their own stream, forked from stream_ and joined
+  // back, since a part's few environments leave the GPU mostly idle while its kernels run.
+  const bool fork = parts_.size() > 1;
+  if (fork && !check(cuEventRecord(fork_, stream_), "cuEventRecord", error)) return false;
   for (const Part& p : parts_) {
     DeviceEnvs v = p.envs;
     v.actions = source;
     v.actions.data = static_cast<const uint8_t*>(source.data) + p.first * source.stride * element;
-    v.actions.step = step;
+    v.actions.count = p.envs.actions.count;
     v.actions.error = p.envs.actions.error;
-    if (!launch_per_env(p.step, v, error)) return false;
+    const CUstream stream = fork ? p.stream : stream_;
+    if ((fork && !check(cuStreamWaitEvent(stream, fork_, 0), "cuStreamWaitEvent", error)) ||
+        !launch_per_env(p.step, v, stream, error) || (render && !launch_render(p, stream, error)))
+      return false;
+    if (fork && !(check(cuEventRecord(p.stepped, stream), "cuEventRecord", error) &&
+                  check(cuStreamWaitEvent(stream_, p.stepped, 0), "cuStreamWaitEvent", error)))
+      return false;
   }
-  return !render || launch_renders(error);
+  return true;
 }
 
 bool DeviceBatch::step(const int32_t* actions, std::string* error) {
@@ -432,7 +463,7 @@ bool DeviceBatch::step(const int32_t* actions, std::string* error) {
 }
 
 bool DeviceBatch::step(const DeviceActions& a, std::string* error) {
-  return launch_step(ActionSource{reinterpret_cast<const void*>(a.data), a.stride, a.is_int64 ? 1 : 0, 0, nullptr},
+  return launch_step(ActionSource{reinterpret_cast<const void*>(a.data), a.stride, a.is_int64 ? 1 : 0, nullptr, nullptr},
                      true, error);
 }
 

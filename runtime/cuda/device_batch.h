@@ -3,9 +3,11 @@
 // per config, each running its own module's kernels on its rows of the one set of buffers. Observations
 // stay on the device.
 //
-// Every launch and copy goes to one CUDA stream (set_stream; the legacy default stream unless set), in
-// call order, so a consumer on that stream needs no synchronisation. Nothing here waits for the device
-// except the calls documented as synchronising (downloads, save_state, load_state).
+// Every launch and copy is ordered on one CUDA stream (set_stream; the legacy default stream unless set), in
+// call order, so a consumer on that stream needs no synchronisation. A mixture's step forks its parts onto
+// streams of their own and joins them back (events), so that small parts step side by side instead of one
+// after another. Nothing here waits for the device except the calls documented as synchronising (downloads,
+// save_state, load_state).
 #pragma once
 
 #include <cuda.h>
@@ -146,13 +148,17 @@ class DeviceBatch {
     int32_t render_threads = 0;
     int32_t render_smem = 0;
     int32_t frames_per_block = 1;
-    CUdeviceptr assets = 0;  ///< owned
+    CUdeviceptr assets = 0;     ///< owned
+    CUstream stream = nullptr;  ///< owned, a mixture's part only: where its step and render run
+    CUevent stepped = nullptr;  ///< owned, a mixture's part only: recorded after them, joined by the batch's stream
   };
 
   DeviceBatch() = default;
-  bool launch_per_env(CUfunction f, const DeviceEnvs& envs, std::string* error);
-  /// Launches a part's render kernel: frames_per_block environments per block.
-  bool launch_render(const Part& p, std::string* error);
+  bool launch_per_env(CUfunction f, const DeviceEnvs& envs, CUstream stream, std::string* error);
+  /// Launches a part's render kernel on `stream`: frames_per_block environments per block.
+  bool launch_render(const Part& p, CUstream stream, std::string* error);
+  /// A mixture's parts: a stream and an event each, and the fork event.
+  bool create_part_streams(std::string* error);
   /// Every part's render, in part order.
   bool launch_renders(std::string* error);
   /// One step of every part reading `source` (element env * stride, env the batch's index), then renders.
@@ -165,13 +171,14 @@ class DeviceBatch {
   CUstream stream_ = nullptr;
   size_t obs_stride_ = 0;
   int32_t segment_count_ = 0;
-  uint64_t steps_ = 0;       ///< steps launched, reported with an out-of-range action
   CUdeviceptr state_ = 0;    ///< one allocation for every per-env array but the observations
   CUdeviceptr obs_buf_ = 0;  ///< observations, then final observations
+  CUdeviceptr step_counts_ = 0;  ///< a StepCount per part: its step launches, numbered in an action's report
   uint8_t* reset_mask_ = nullptr;        ///< device buffer for a reset's mask
   std::vector<uint64_t> seeds_;          ///< host copy of the device seeds
   ActionError* action_error_ = nullptr;  ///< host-mapped, one per part (its env is the part's index)
   CUfunction sample_actions_ = nullptr;  ///< the first part's (every module's is the same code)
+  CUevent fork_ = nullptr;               ///< a mixture only: recorded on stream_, waited for by the parts' streams
 };
 
 }  // namespace kage

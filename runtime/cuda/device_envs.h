@@ -16,7 +16,16 @@ struct ActionError {
   uint32_t state;
   int32_t env;
   int64_t value;
-  uint64_t step;   ///< ActionSource::step of the launch
+  uint64_t step;   ///< the launch's number: StepCount::steps + 1 when it ran
+};
+
+/// A batch part's step launches, counted on the device (so that a launch replayed from a CUDA graph is
+/// numbered as a fresh one would be): the warps that finished their environments' step add to `done`;
+/// the last one resets it and adds 1 to `steps`.
+struct StepCount {
+  uint64_t steps;
+  uint32_t done;
+  uint32_t unused;
 };
 
 /// Where a step kernel reads its actions: element `env * stride` of an int32 or int64 device array.
@@ -24,7 +33,7 @@ struct ActionSource {
   const void* data;
   int64_t stride;        ///< in elements
   int32_t is_int64;      ///< 0: int32 elements, 1: int64
-  uint64_t step;         ///< the host's step counter, reported with an out-of-range value
+  StepCount* count;      ///< device memory; null: launches not counted (no report either)
   ActionError* error;    ///< host-mapped; values outside 0..7 are reported here (then masked, spec 3.2)
 };
 

@@ -82,11 +82,27 @@ __device__ __forceinline__ int32_t load_action(const ActionSource& a, int32_t en
   if ((v < 0 || v > 7) && a.error && atomicCAS(&a.error->state, 0u, 1u) == 0u) {
     a.error->env = env;
     a.error->value = v;
-    a.error->step = a.step;
+    a.error->step = a.count ? a.count->steps + 1 : 0;
     __threadfence_system();
     atomicExch(&a.error->state, 2u);
   }
   return static_cast<int32_t>(v);
+}
+
+/// Counts a finished step launch in `a.count` (StepCount): called by every thread of the launch after its
+/// environment's step (and so after any report of its action read the count). One atomic per warp; the warp
+/// that completes the launch's `num_envs` environments resets `done` for the next launch on the stream.
+__device__ __forceinline__ void count_step(const ActionSource& a, int32_t num_envs) {
+  if (!a.count) return;
+  const int32_t env = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
+  const uint32_t together = __activemask();
+  const uint32_t stepped = __ballot_sync(together, env < num_envs);
+  if (static_cast<int32_t>(threadIdx.x % 32) != __ffs(static_cast<int>(together)) - 1 || stepped == 0) return;
+  const uint32_t n = static_cast<uint32_t>(__popc(static_cast<int>(stepped)));
+  if (atomicAdd(&a.count->done, n) + n == static_cast<uint32_t>(num_envs)) {
+    a.count->done = 0;
+    a.count->steps += 1;
+  }
 }
 
 /// Where the episode driver puts one environment's step: reward, flags and info in the batch's

@@ -174,7 +174,10 @@ __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n,
 /// per block, ceil(num_envs / grid) environments per block), kage_sample_actions. Use once per module.
 #define KAGE_INSTANTIATE_KERNELS(CFG)                                                                     \
   extern "C" __global__ void kage_reset(const kage::DeviceEnvs e) { kage::reset_body<CFG>(e); }           \
-  extern "C" __global__ void kage_step(const kage::DeviceEnvs e) { kage::step_body<CFG>(e); }   \
+  extern "C" __global__ void kage_step(const kage::DeviceEnvs e) {                                        \
+    kage::step_body<CFG>(e);                                                                              \
+    kage::count_step(e.actions, e.num_envs);                                                              \
+  }                                                                                                       \
   extern "C" __global__ void __launch_bounds__(kage::RenderBounds<CFG>::kThreads,                          \
                                                kage::RenderBounds<CFG>::kMinBlocks) kage_render(const kage::DeviceEnvs e) {              \
     __shared__ kage::BlockShared sh;                                                                      \

@@ -27,6 +27,7 @@ class EvalSettings:
     frame_stack: bool = False
     greedy: bool = False  # QUIRK off: sampled actions, as the original
     bf16: bool = False
+    cuda_graph: bool = False  # each step (policy, environments, records) replayed as one CUDA graph
 
 
 @dataclasses.dataclass
@@ -92,26 +93,63 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
     stack = FrameStack(torch.stack(frames)) if settings.frame_stack else None
     episodes = settings.episodes
     chunk = -(-episodes // n) * episode_length
+
+    def step(uniform: torch.Tensor) -> torch.Tensor:
+        """One step of every evaluation: the policy on the frames, the environments, the records' row."""
+        obs = stack.stack if stack else torch.stack(frames)             # [K * C, E, H, W, ch]
+        # QUIRK: sampled, not greedy (Gumbel-max: an exact categorical sampler with no host check).
+        actions, _, _ = policy_step(agent, obs.view(len(envs), configs * n, *obs.shape[2:]),
+                                    uniform.reshape(len(envs), configs * n, num_actions),
+                                    bf16=settings.bf16, greedy=settings.greedy)
+        kage.step_batches(flat_envs, actions.view(len(flat_envs), n))
+        streams.wait_for(env_streams)
+        if stack:
+            stack.push(torch.stack(frames), metrics.mask())
+        return metrics.rows()
+
+    graph = StepGraph(step) if graphable(settings, flat_envs) else None
     records, waves = [], 0
     while True:
         noise = random.uniform(0, counter.fill_(waves), (chunk, n, num_actions))  # each evaluation's draws for the chunk
         waves += 1
-        for step in range(chunk):
-            obs = stack.stack if stack else torch.stack(frames)             # [K * C, E, H, W, ch]
-            # QUIRK: sampled, not greedy (Gumbel-max: an exact categorical sampler with no host check).
-            actions, _, _ = policy_step(agent, obs.view(len(envs), configs * n, *obs.shape[2:]),
-                                        noise[:, step].reshape(len(envs), configs * n, num_actions),
-                                        bf16=settings.bf16, greedy=settings.greedy)
-            kage.step_batches(flat_envs, actions.view(len(flat_envs), n))
-            streams.wait_for(env_streams)
-            if stack:
-                stack.push(torch.stack(frames), metrics.mask())
-            records.append(metrics.rows())
+        for t in range(chunk):
+            records.append(graph(noise[:, t]) if graph else step(noise[:, t]))
         if torch.stack(records)[:, :, 0].sum((0, 2)).min().item() >= episodes:  # the one host read
             break
     host = torch.stack(records).cpu()
     results = [summarize_evaluation(host[:, i], episodes) for i in range(len(flat_envs))]
     return [results[k * configs:(k + 1) * configs] for k in range(len(envs))]
+
+
+def graphable(settings: EvalSettings, envs: List["kage.VecEnv"]) -> bool:
+    """Whether the evaluation's step can be a CUDA graph: asked for, without a frame stack (whose buffer is
+    rebuilt each step), and every batch on a stream of its own (a capture cannot use the legacy default one)."""
+    return settings.cuda_graph and not settings.frame_stack and all(env.stream != 0 for env in envs)
+
+
+class StepGraph:
+    """An evaluation's step replayed as one CUDA graph: the policy's kernels, every batch's step and render
+    launches, and the records' row, with one launch from the host per step instead of hundreds. The first call
+    steps eagerly (cuDNN and Triton choose their kernels outside the capture); the second captures the step,
+    which steps nothing, then replays it, as every later call does. The environments' launches are captured
+    on their own streams, forked from and joined to the capture's, so the batches still step side by side; a
+    batch numbers its step launches on the device, so an action's report names the replayed step."""
+
+    def __init__(self, step):
+        self.step, self.graph = step, None
+        self.uniform = self.rows = None
+
+    def __call__(self, uniform: torch.Tensor) -> torch.Tensor:
+        if self.uniform is None:
+            self.uniform = uniform.clone()
+            return self.step(uniform)
+        self.uniform.copy_(uniform)
+        if self.graph is None:
+            self.graph = torch.cuda.CUDAGraph()
+            with torch.cuda.graph(self.graph):
+                self.rows = self.step(self.uniform)
+        self.graph.replay()
+        return self.rows.clone()
 
 
 def summarize_evaluation(records: torch.Tensor, episodes: int) -> Dict[str, Optional[float]]:

@@ -2,13 +2,15 @@
 
 A run's batch is a few hundred environments (a mixture's parts fewer still): its step and render kernels are
 too small to fill the GPU and last about as long as a full one. On one stream a pack's K batches run one after
-another; on a stream per run they overlap (a mixture's parts still run one after another on their run's
-stream). A batch orders itself after the learner
-when it takes the actions (the DLPack protocol, kage.actions); the learner orders itself after the batches
-with `wait_for` before it reads their outputs, and the rest of the loop is unchanged."""
+another; on a stream per run they overlap (and a mixture's parts, each on a stream of the batch's own). A batch
+orders itself after the learner when it takes the actions (the DLPack protocol, kage.actions); the learner
+orders itself after the batches with `wait_for` before it reads their outputs, and the rest of the loop is
+unchanged. Under --cuda-graph the whole step is one graph (GraphedStep)."""
 from typing import Iterable, List, Optional
 
 import torch
+
+import kage
 
 
 def new_stream(device: str) -> Optional[torch.cuda.Stream]:
@@ -28,3 +30,37 @@ def wait_for(streams: Iterable[Optional[torch.cuda.Stream]]) -> None:
         if stream is not None:
             current = current or torch.cuda.current_stream()
             current.wait_stream(stream)
+
+
+def release(streams: Iterable[Optional[torch.cuda.Stream]]) -> None:
+    """Orders each of `streams` after the work queued so far on the current stream: after a GraphedStep's
+    replays (which run on the current stream), before a batch's own work (a reset, a saved state) on its stream."""
+    current = None
+    for stream in streams:
+        if stream is not None:
+            current = current or torch.cuda.current_stream()
+            stream.wait_stream(current)
+
+
+class GraphedStep:
+    """`kage.step_batches(envs, actions)` and the learner's `wait_for` as one CUDA graph: one launch a step
+    instead of one or more per batch and per mixture part. Captured at the first call (the capture steps
+    nothing; the replay that follows does), and again when the batches or the actions' memory change (a
+    schedule's stage opens new batches). The batches' launches are captured on their own streams, forked from
+    the capture's and joined back, so they still run side by side; a batch numbers its steps on the device, so an
+    action's report names the replayed step. The replays run on the current stream: `release` the batches'
+    streams before queueing work on them directly."""
+
+    def __init__(self):
+        self.graph, self.envs, self.actions = None, [], None
+
+    def __call__(self, envs: List["kage.VecEnv"], actions: torch.Tensor) -> None:
+        if (self.graph is None or len(envs) != len(self.envs) or any(a is not b for a, b in zip(envs, self.envs))
+                or actions.data_ptr() != self.actions):
+            self.graph = None  # the old graph's launches name batches that may be closed
+            graph = torch.cuda.CUDAGraph()
+            with torch.cuda.graph(graph):
+                kage.step_batches(envs, actions)
+                wait_for(streams_of(envs))
+            self.graph, self.envs, self.actions = graph, list(envs), actions.data_ptr()
+        self.graph.replay()

@@ -122,7 +122,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     optimizer = torch.optim.Adam(agent.parameters(), lr=args.learning_rate, eps=1e-5, fused=device.type == "cuda")
     random = CounterRandom([a.seed for a in pack], device)
     counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
-    settings = EvalSettings(args.eval_episodes, args.use_frame_stack, args.eval_greedy, args.bf16)
+    settings = EvalSettings(args.eval_episodes, args.use_frame_stack, args.eval_greedy, args.bf16, args.cuda_graph)
 
     # Rollout storage, [T, K, N, ...] on the device (§2.5 step 1d).
     obs = torch.zeros((T, K, N, height, width, channels), dtype=torch.uint8, device=device)
@@ -164,6 +164,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     augment_minibatch = augment if args.augment_mode in ("update", "drac") else None
     augment_rollout = RolloutAugment(augment, args.augment, random, T, observe().shape, device,
                                      args.cuda_graph) if args.augment_mode == "rollout" else None
+    env_step = streams.GraphedStep() if args.cuda_graph else None  # the rollout policy's actions keep their memory
 
     for iteration in range(start_iteration, last_iteration + 1):
         iteration_start = time.perf_counter()
@@ -199,8 +200,11 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                 action, logprob, value = rollout(obs[step], noise[:, step])
                 values[step], actions[step], logprobs[step] = value, action, logprob
             with timer("env"):
-                kage.step_batches([run.env for run in runs], action)
-                streams.wait_for(run.stream for run in runs)
+                if env_step:
+                    env_step([run.env for run in runs], action)
+                else:
+                    kage.step_batches([run.env for run in runs], action)
+                    streams.wait_for(run.stream for run in runs)
                 reward = torch.stack(env_reward)
                 state.next_done = (torch.stack(env_terminated) | torch.stack(env_truncated)).float()  # QUIRK (§2.5 b)
                 finished = finished_at[step] = views.episode.mask()
@@ -223,6 +227,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         if read_once:
             with timer("env"):
                 episode_sums += state.tally(views.episode.rows(), finished_at.sum(0))
+        if env_step:  # the batches' own work (a stage's reset, a saved state) after the graph's steps
+            streams.release(run.stream for run in runs)
         state.global_step += args.batch_size  # §2.5 step 2
 
         with torch.no_grad(), timer("forward"):  # §2.5 step 3
