@@ -2,7 +2,7 @@
 among them, whose parts fork onto their own streams) and replayed equals the same batches stepped eagerly,
 byte for byte, across autoresets; an out-of-range action in a replay is named by that replay's step number
 (batches count their step launches on the device); an evaluation with --cuda-graph (kage.ppo.evaluation's
-StepGraph) gives the eager evaluation's numbers."""
+StepGraph) gives the eager evaluation's numbers, in float32 and under the table's speed flags."""
 import pytest
 import torch
 
@@ -91,12 +91,16 @@ def eval_envs():
             for s in streams]
 
 
-def test_an_evaluation_as_a_graph_gives_the_eager_numbers():
-    agent = Agent([1, 2], 3, 128, 128, torch.device("cuda"))
+@pytest.mark.parametrize("table_flags", [False, True])
+def test_an_evaluation_as_a_graph_gives_the_eager_numbers(table_flags):
+    """Plain float32, and the table's speed flags (bf16, fused input, Triton convolutions)."""
+    speed = dict(bf16=True, fused_input=True, triton_conv=True) if table_flags else {}
+    agent = Agent([1, 2], 3, 128, 128, torch.device("cuda"), **speed)
     seeds = [[101, 102, 103], [201, 202, 203]]
     results = {}
     for cuda_graph in (False, True):
-        settings = EvalSettings(episodes=12, cuda_graph=cuda_graph)  # two waves of 500 steps: 16 episodes each
+        # two waves of 500 steps: 16 episodes each
+        settings = EvalSettings(episodes=12, bf16=table_flags, cuda_graph=cuda_graph)
         results[cuda_graph] = evaluate(agent, eval_envs(), seeds, settings)
     assert results[True] == results[False]
     assert all(r["episodes"] >= 12 for run in results[True] for r in run)
