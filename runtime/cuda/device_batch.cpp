@@ -463,7 +463,8 @@ bool DeviceBatch::step(const int32_t* actions, std::string* error) {
 }
 
 bool DeviceBatch::step(const DeviceActions& a, std::string* error) {
-  return launch_step(ActionSource{reinterpret_cast<const void*>(a.data), a.stride, a.is_int64 ? 1 : 0, nullptr, nullptr},
+  return launch_step(ActionSource{reinterpret_cast<const void*>(a.data), a.stride, a.is_int64 ? 1 : 0, nullptr,
+                                  nullptr},
                      true, error);
 }
 

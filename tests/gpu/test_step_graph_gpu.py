@@ -19,7 +19,8 @@ N = 48
 
 def batches(streams, seed=10):
     configs = [SKELETON, [SKELETON, FILTERS_4, FILTERS_5], FILTERS_5]
-    return [kage.make_vec(c, N, device="cuda", seed=seed + i, stream=s) for i, (c, s) in enumerate(zip(configs, streams))]
+    return [kage.make_vec(c, N, device="cuda", seed=seed + i, stream=s)
+            for i, (c, s) in enumerate(zip(configs, streams))]
 
 
 def outputs(env) -> dict:

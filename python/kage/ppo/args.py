@@ -89,7 +89,8 @@ class Args:
     # Speed (off: plain eager float32; see kage.bench speed)
     bf16: bool = field(default=False, metadata={"help": "bfloat16 autocast for the network (GPU)"})
     channels_last: bool = field(default=False, metadata={"help": "channels-last convolutions"})
-    cuda_graph: bool = field(default=False, metadata={"help": "replay the rollout's policy step, and each evaluation step, as CUDA graphs"})
+    cuda_graph: bool = field(default=False, metadata={
+        "help": "replay the rollout's policy step, the environments' step and each evaluation step as CUDA graphs"})
     fused_input: bool = field(default=False, metadata={
         "help": "one pass from uint8 frames to 4x4 blocks in the network's dtype; conv1 as the equal 2x2 conv"})
     triton_conv: bool = field(default=False, metadata={
