@@ -41,6 +41,18 @@ def test_only_the_tasks_named(capsys, tmp_path, monkeypatch):
     assert gpu_lines[0].startswith("  GPU 0: task 4, weight 85") and gpu_lines[1].startswith("  GPU 1: task 5, ")
 
 
+def test_the_gpus_are_named_as_given(capsys, tmp_path, monkeypatch):
+    """--gpus 3,1 trains on GPUs 3 and 1 (the runner's [gpu 3] and [gpu 1]): the dry run names them so, in that
+    order, the first taking the heaviest task."""
+    monkeypatch.chdir(tmp_path)
+    status, out = dry(capsys, "--pack", "12", "--gpus", "3,1")
+    assert status == 0
+    assert "on 2 GPUs, longest first" in out
+    gpu_lines = [line for line in out.splitlines() if line.startswith("  GPU ")]
+    assert [line.split(":")[0] for line in gpu_lines] == ["  GPU 3", "  GPU 1"]
+    assert gpu_lines[0].startswith("  GPU 3: tasks 0, ")
+
+
 def test_hand_out_gives_each_task_to_the_first_free_worker():
     # Worker 0 takes 5 and worker 1 takes 4; worker 1 (free at 4) takes 3 (to 7); worker 0 (free at 5) takes 3
     # (to 8); worker 1 (free at 7) takes 2 (to 9).
@@ -64,3 +76,14 @@ def test_all_gpus_without_a_gpu_asks_for_a_list(capsys, tmp_path, monkeypatch):
     monkeypatch.setattr(gpus, "device_count", lambda: 0)
     with pytest.raises(SystemExit, match="give the lease's GPUs as a list, e.g. --gpus 0,1,2,3"):
         dry(capsys, "--gpus", "all")
+
+
+def test_an_unknown_suite_is_named_with_the_shipped_ones(capsys, tmp_path, monkeypatch):
+    """Not a file system's refusal of --out: the suite's name, where it was looked for, and the choices."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as stop:
+        run.main(["suites/kage_bnch.yaml", "--seeds", "1", "--out", "never-made", "--dry-run"])
+    text = str(stop.value)
+    assert text.startswith("kage.bench run: suite 'suites/kage_bnch.yaml' is neither a path nor a shipped suite name")
+    assert "near names: kage_bench" in text and "--out" not in text and ": ?:" not in text
+    assert not (tmp_path / "never-made").exists()

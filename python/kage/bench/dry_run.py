@@ -5,9 +5,9 @@ from typing import List, Optional
 from kage.bench import gpus, tasks
 
 
-def describe(bench, workers: Optional[int], only: Optional[List[int]]) -> str:
-    """The task table of `bench`, then, for `workers` GPUs, the tasks each would train (longest first) and its
-    share of the busiest GPU's work."""
+def describe(bench, devices: Optional[List[int]], only: Optional[List[int]]) -> str:
+    """The task table of `bench`, then, for the GPUs `devices` (the indices --gpus names), the tasks each would
+    train (longest first) and its share of the busiest GPU's work."""
     table = bench.table()
     lines = [f"kage.bench run --dry-run: {len(table)} tasks, {sum(map(len, table))} runs (--pack {bench.pack}"
              f"{', --share-training' if bench.share_training else ''}); nothing trained or written"]
@@ -16,13 +16,13 @@ def describe(bench, workers: Optional[int], only: Optional[List[int]]) -> str:
         configs = 1 + len(task[0][0].evals)
         lines.append(f"task {i}: {plural(len(task), 'run')} x {configs} configs, weight {gpus.task_weight(task)}: "
                      f"{', '.join(units)}")
-    if workers:
+    if devices:
         order = gpus.longest_first(table, only if only is not None else list(range(len(table))))
-        taken, loads = gpus.hand_out([gpus.task_weight(table[i]) for i in order], [0] * workers)
+        taken, loads = gpus.hand_out([gpus.task_weight(table[i]) for i in order], [0] * len(devices))
         busiest = max(loads) or 1
-        lines.append(f"on {workers} GPUs, longest first (weight: a run's evaluation of one config, a run's "
+        lines.append(f"on {plural(len(devices), 'GPU')}, longest first (weight: a run's evaluation of one config, a run's "
                      f"training counting {gpus.TRAINING_AS_CONFIGS}):")
-        for g, (worker, load) in enumerate(zip(taken, loads)):
+        for g, worker, load in zip(devices, taken, loads):
             names = f"{'task' if len(worker) == 1 else 'tasks'} {', '.join(str(order[j]) for j in worker)}"
             lines.append(f"  GPU {g}: {names if worker else 'no task'}, weight {load} "
                          f"({100 * load / busiest:.0f} % of the busiest)")
@@ -33,15 +33,15 @@ def plural(count: int, noun: str) -> str:
     return f"{count} {noun}{'' if count == 1 else 's'}"
 
 
-def worker_count(text: str) -> int:
-    """--gpus for a dry run: a list's length, or 'all': this machine's GPUs (none needed for a list)."""
+def devices_of(text: str) -> List[int]:
+    """--gpus for a dry run: the indices of a list, or 'all': this machine's GPUs (none needed for a list)."""
     if text == "all":
         count = gpus.device_count()
         if count == 0:
             raise SystemExit("kage.bench run --dry-run: --gpus all, but torch sees no CUDA GPU here: give the lease's "
                              "GPUs as a list, e.g. --gpus 0,1,2,3")
-        return count
-    return len(gpus.index_list("--gpus", text, 1 << 16, "use 'all' or GPU indices like 0,2", "indices are"))
+        return list(range(count))
+    return gpus.index_list("--gpus", text, 1 << 16, "use 'all' or GPU indices like 0,2", "indices are")
 
 
 def tasks_of(text: Optional[str], table: List[List[tasks.Job]]) -> Optional[List[int]]:

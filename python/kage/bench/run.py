@@ -494,7 +494,7 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
         if args.task is not None:
             raise SystemExit("kage.bench run: --dry-run shows every task: drop --task")
         only = dry_run.tasks_of(args.tasks, bench.table())
-        print(dry_run.describe(bench, dry_run.worker_count(args.gpus) if args.gpus else None, only))
+        print(dry_run.describe(bench, dry_run.devices_of(args.gpus) if args.gpus else None, only))
         return 0
     if bench.device == "cuda":
         import torch  # here: kage.bench slurm plans on machines without torch's GPU build

@@ -53,7 +53,10 @@ def named_errors(path: str):
 
 def os_error_text(program: str, e: OSError, flag: str) -> str:
     """One line for a file system's refusal: the file, the reason, and what to do (`flag`: the option that
-    chose where to write)."""
+    chose where to write). An error raised with a message alone (a name that is neither a path nor a shipped
+    file, kage.resources) is that message: it names the file and the choices."""
+    if e.errno is None:
+        return f"{program}: {e}"
     where = e.filename if e.filename is not None else "?"
     if e.errno in (errno.ENOSPC, errno.EDQUOT):
         fix = "free space on that file system (or raise the quota), then run the same command again: it resumes"
