@@ -74,8 +74,9 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
     environments with its own seed and sampling stream, all stepped together: one forward pass per step.
     Sampled actions until `episodes` episodes have finished in each. Steps are queued without a host
     synchronisation: every KAGE episode ends by truncation at `episode_length` (§2.3), so
-    ceil(episodes / envs) waves of episode_length steps finish them; the host checks the counts once,
-    after the waves (and steps on, a wave at a time, if one fell short)."""
+    ceil(episodes / envs) waves of episode_length steps finish them; the records stay on the device until the
+    host reads them once, after the waves, and checks the counts there (it steps on, as many waves again, if one
+    fell short)."""
     device = next(agent.parameters()).device
     flat_envs = [e for run in envs for e in run]
     specs = [env.resolved_specs[0]["config"] for env in flat_envs]  # the hidden game's: a mixture's configs share it
@@ -108,15 +109,14 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
         return metrics.rows()
 
     graph = StepGraph(step) if graphable(settings, flat_envs) else None
-    records, waves = [], 0
+    waves = []  # each wave's records, on the host
     while True:
-        noise = random.uniform(0, counter.fill_(waves), (chunk, n, num_actions))  # each evaluation's draws for the chunk
-        waves += 1
-        for t in range(chunk):
-            records.append(graph(noise[:, t]) if graph else step(noise[:, t]))
-        if torch.stack(records)[:, :, 0].sum((0, 2)).min().item() >= episodes:  # the one host read
+        noise = random.uniform(0, counter.fill_(len(waves)), (chunk, n, num_actions))  # each evaluation's draws
+        wave = [graph(noise[:, t]) if graph else step(noise[:, t]) for t in range(chunk)]
+        waves.append(torch.stack(wave).cpu())  # the one host read, unless the episodes fell short
+        host = torch.cat(waves)
+        if host[:, :, 0].sum((0, 2)).min().item() >= episodes:
             break
-    host = torch.stack(records).cpu()
     results = [summarize_evaluation(host[:, i], episodes) for i in range(len(flat_envs))]
     return [results[k * configs:(k + 1) * configs] for k in range(len(envs))]
 
