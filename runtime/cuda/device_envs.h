@@ -25,7 +25,6 @@ struct ActionError {
 struct StepCount {
   uint64_t steps;
   uint32_t done;
-  uint32_t unused;
 };
 
 /// Where a step kernel reads its actions: element `env * stride` of an int32 or int64 device array.
