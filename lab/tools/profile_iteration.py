@@ -5,7 +5,7 @@ the trainer flags default to the fastest recorded (lab/2026-11-24-h200-triton-co
 untimed ones (autotuning, graph capture, cuDNN's search), one timed without the profiler, one profiled.
 
 usage: python3 lab/tools/profile_iteration.py [--packs 16] [--warmup 1] [--top 25] [--trace FILE.json]
-       [trainer flags]
+       [trainer flags]   (shape_black unless they name --train-config-path, --train-config-paths or --train-schedule)
 """
 import argparse
 import collections
@@ -109,8 +109,10 @@ def main() -> None:
     p.add_argument("--trace", help="also write the profiled iteration's Chrome trace here (Perfetto opens it)")
     a, trainer_flags = p.parse_known_args()
     trainer_flags = trainer_flags or FASTEST
-    base = train.parse_args(["--train-config-path", "configs/kage_bench/bases/shape_black.yaml", "--device", "cuda",
-                             "--run-eval-every", "0", *trainer_flags])
+    # shape_black unless the flags name what to train on (a config, a mixture or a schedule)
+    named = any(flag in trainer_flags for flag in ("--train-config-path", "--train-config-paths", "--train-schedule"))
+    default = [] if named else ["--train-config-path", "configs/kage_bench/bases/shape_black.yaml"]
+    base = train.parse_args([*default, "--device", "cuda", "--run-eval-every", "0", *trainer_flags])
     import triton  # the versions the figures belong to
     print(f"{torch.cuda.get_device_name()}, torch {torch.__version__}, triton {triton.__version__}, K = {a.packs}, "
           f"{' '.join(trainer_flags)}", flush=True)
