@@ -361,7 +361,7 @@ class GpuEnv final : public Env {
 std::optional<CudaModule> gpu_module(const std::string& spec_hash, const std::string& source, const std::string& fatbin,
                                      std::string* error) {
   if (!fatbin.empty()) return CudaModule::load_file(fatbin, error);
-  return CudaModule::compile(source, "kage_" + spec_hash.substr(0, 16) + ".cu", generated_source_options(), error);
+  return CudaModule::compile(source, generated_file_name(spec_hash), generated_source_options(), error);
 }
 
 /// One config of a GPU batch: its Spec hash and lowered parameters, its generated source (or fatbin path),

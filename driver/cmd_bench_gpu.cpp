@@ -111,12 +111,13 @@ std::optional<Job> make_job(const std::string& label, const Spec& spec, std::str
 void compile_all(std::vector<Job>& jobs, const std::string& arch, std::ostream& progress) {
   std::vector<KernelJob> kernels;
   for (Job& j : jobs) kernels.push_back(std::move(j.kernels));
-  compile_jobs(kernels, generated_source_options(), arch, compile_threads(kernels.size()), [&](const KernelJob& k, size_t done) {
+  const auto report = [&](const KernelJob& k, size_t done) {
     progress << "kagec bench: config " << done << " of " << jobs.size() << ", "
              << jobs[static_cast<size_t>(&k - kernels.data())].label << ": "
              << (!k.cubin ? "FAILED" : k.cached ? "cached" : "compiled in " + fixed(k.seconds, 1) + " s") << '\n'
              << std::flush;
-  });
+  };
+  compile_jobs(kernels, generated_source_options(), arch, compile_threads(kernels.size()), report);
   for (size_t i = 0; i < jobs.size(); ++i) jobs[i].kernels = std::move(kernels[i]);
 }
 

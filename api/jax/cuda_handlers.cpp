@@ -58,7 +58,7 @@ std::optional<CudaModule> load_module(const JaxConfig& c, std::string* error) {
   } else {
     source = generate_source({c.spec_hash, c.latent, c.visual}).text;
   }
-  return CudaModule::compile(source, "kage_" + c.spec_hash.substr(0, 16) + ".cu", generated_source_options(), error);
+  return CudaModule::compile(source, generated_file_name(c.spec_hash), generated_source_options(), error);
 }
 
 bool check(CUresult r, const char* what, std::string* error) {

@@ -180,11 +180,13 @@ std::string generate_latent_section(const LatentParams& p) {
   return fill(chomp(latent_section_inc_template_text()), {{"LATENT_FIELDS", initialisers(p)}});
 }
 
+std::string generated_file_name(const std::string& spec_hash) { return "kage_" + spec_hash.substr(0, 16) + ".cu"; }
+
 GeneratedSource generate_source(const CodegenInput& in) {
   KAGE_INTERNAL_ASSERT(in.spec_hash.size() == 64, "codegen needs the 64-digit spec hash");
   GeneratedSource g;
   const std::string short_hash = in.spec_hash.substr(0, 16);
-  g.file_name = "kage_" + short_hash + ".cu";
+  g.file_name = generated_file_name(in.spec_hash);
   g.config_name = "KageConfig_" + short_hash;
   g.latent_section = generate_latent_section(in.latent);
   g.latent_hash = sha256_hex(g.latent_section);

@@ -21,6 +21,10 @@ struct CodegenInput {
   VisualParams visual{};
 };
 
+/// The generated file's name for a Spec hash (64 hex digits): kage_<first 16>.cu. NVRTC's diagnostics name it,
+/// also for a source read back from a compile directory.
+std::string generated_file_name(const std::string& spec_hash);
+
 /// One generated file and the facts a manifest or a certificate records about it.
 struct GeneratedSource {
   std::string file_name;       ///< kage_<first 16 hex of the spec hash>.cu

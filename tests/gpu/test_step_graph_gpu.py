@@ -10,6 +10,7 @@ import kage
 from kage.ppo.agent import Agent
 from kage.ppo.evaluation import EvalSettings, evaluate
 from support import ROOT
+from test_step_batches_gpu import assert_same_outputs
 
 BENCH = ROOT / "configs/kage_bench"
 SKELETON, FILTERS_4, FILTERS_5 = (str(BENCH / p) for p in ("bases/image_skeleton.yaml", "filters/4-eval.yaml",
@@ -21,14 +22,6 @@ def batches(streams, seed=10):
     configs = [SKELETON, [SKELETON, FILTERS_4, FILTERS_5], FILTERS_5]
     return [kage.make_vec(c, N, device="cuda", seed=seed + i, stream=s)
             for i, (c, s) in enumerate(zip(configs, streams))]
-
-
-def outputs(env) -> dict:
-    obs, reward, terminated, truncated, info = env.outputs()
-    arrays = {"obs": obs, "reward": reward, "terminated": terminated, "truncated": truncated,
-              "final_obs": info["final_obs"], "_final": info["_final"]}
-    arrays.update({f"final_info/{k}": v for k, v in info["final_info"].items()})
-    return {k: torch.from_dlpack(v).clone() for k, v in arrays.items()}
 
 
 def captured_step(envs, actions: torch.Tensor) -> torch.cuda.CUDAGraph:
@@ -51,9 +44,7 @@ def test_replayed_steps_equal_eager_steps():
     actions = torch.zeros((3, N), dtype=torch.int64, device="cuda")
     graph = captured_step(graphed, actions)
     torch.cuda.synchronize()
-    assert all(torch.equal(a, b) for x, y in zip(graphed, eager) for a, b in zip(outputs(x).values(),
-                                                                                   outputs(y).values())), \
-        "the capture stepped the batches"
+    assert_same_outputs(graphed, eager, "after the capture, which must step nothing")
     finished = 0
     for step in range(560):  # past the 500-step truncation of every episode
         actions.copy_(torch.randint(0, 8, (3, N), device="cuda", generator=generator))
@@ -61,10 +52,7 @@ def test_replayed_steps_equal_eager_steps():
         kage.step_batches(eager, actions)
         torch.cuda.synchronize()
         if step % 50 == 0 or step >= 495:
-            for x, y in zip(graphed, eager):
-                ox, oy = outputs(x), outputs(y)
-                for key in ox:
-                    assert torch.equal(ox[key], oy[key]), (step, key)
+            assert_same_outputs(graphed, eager, step)
         finished += sum(int(torch.from_dlpack(env.outputs()[4]["_final"]).sum()) for env in graphed)
     assert finished >= 3 * N
 

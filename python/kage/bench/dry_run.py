@@ -20,8 +20,8 @@ def describe(bench, devices: Optional[List[int]], only: Optional[List[int]]) -> 
         order = gpus.longest_first(table, only if only is not None else list(range(len(table))))
         taken, loads = gpus.hand_out([gpus.task_weight(table[i]) for i in order], [0] * len(devices))
         busiest = max(loads) or 1
-        lines.append(f"on {plural(len(devices), 'GPU')}, longest first (weight: a run's evaluation of one config, a run's "
-                     f"training counting {gpus.TRAINING_AS_CONFIGS}):")
+        lines.append(f"on {plural(len(devices), 'GPU')}, longest first (weight: a run's evaluation of one config, "
+                     f"a run's training counting {gpus.TRAINING_AS_CONFIGS}):")
         for g, worker, load in zip(devices, taken, loads):
             names = f"{'task' if len(worker) == 1 else 'tasks'} {', '.join(str(order[j]) for j in worker)}"
             lines.append(f"  GPU {g}: {names if worker else 'no task'}, weight {load} "
