@@ -10,7 +10,7 @@ set -uo pipefail
 OUT=${OUT:-/tmp/kage-device-out}
 mkdir -p "$OUT"
 drac=(env COMMIT="$COMMIT" GPUS=all TASKS=0,6,7,8 SUITE=kage_bench SEEDS=1-5 PACK=5 DIR=/tmp/kage-m-drac_color_jitter
-      PUBLISHED=results/methods/drac_color_jitter/packs OUT="$OUT/drac" MAX_FILES=6
+      PUBLISHED=results/methods/drac_color_jitter/packs OUT="$OUT/drac" MAX_FILES=5
       FLAGS="--bf16 --fused-input --cuda-graph --triton-conv --augment kage.ppo.augment:color_jitter --augment-mode drac")
 case "${PART:?PART=start or wait}" in
 start)
