@@ -19,7 +19,7 @@ for i in 1 2; do
   speed 180 --packs 5 --iterations 8 --json "$OUT/rates_pair$i.jsonl" >"$OUT/rates_pair$i.log" 2>&1 &
 done
 wait
-tail -3 "$OUT"/rates_pair*.log | tee -a "$OUT/rates.log"
+tail -n 3 "$OUT"/rates_pair*.log | tee -a "$OUT/rates.log"
 left=$((560 - SECONDS))
 echo "== $(date -u +%T) the mixture of four at K = 16, no graph, profiled (${left} s left)" | tee -a "$OUT/rates.log"
 if [ "$left" -gt 90 ]; then
