@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One call on a lease of four GPUs (nvidia-h200-x4), carry [".deps"]: the arms of SUITE (default probe_suite.yaml,
 # its three; probe_suite_looks.yaml has four), seeds 1-5, one pack of five runs a GPU, in DIR, for STEPS steps a
-# run at the table's flags; after LIMIT seconds of the call (or once the runner ends) every run's metrics.jsonl so far comes home in $OUT/probe_runs.tar.gz.
+# run at the table's flags; after LIMIT seconds of the call (or once the runner ends) every run's metrics.jsonl
+# so far comes home in $OUT/probe_runs.tar.gz.
 #   STEPS=3276800 LIMIT=430 bash lab/2026-11-28-h200x4-loo-probe/probe_device.sh
 #   SUITE=probe_suite_looks.yaml DIR=/tmp/kage-loo-looks STEPS=6553600 LIMIT=400 \
 #     bash lab/2026-11-28-h200x4-loo-probe/probe_device.sh
