@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # One lease of four GPUs (nvidia-h200-x4), issue 40: DrAC colour jitter's tasks 0, 6, 7 and 8 of `--pack 5`
 # (lab/tools/table_device.sh in DIR: one task a GPU, longest first), the GPU tests of the commits since the last
-# lease beside them on GPU 3 (task 6, the lightest), and, in the calls after, what the GPUs do once their task is
-# packed (PART=extra). Run from the repository root with carry [".deps"]. PART picks the call:
+# lease beside them on GPU 3 (task 6, the lightest). Run from the repository root with carry [".deps"]. PART
+# picks the call:
 #   PART=start COMMIT=... bash lab/2026-11-28-h200x4-drac-tasks/lease_device.sh   # build, runner, GPU tests
 #   PART=wait  COMMIT=... bash lab/2026-11-28-h200x4-drac-tasks/lease_device.sh   # wait for the runner, pack
 set -uo pipefail

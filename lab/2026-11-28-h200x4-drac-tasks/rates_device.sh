@@ -16,7 +16,7 @@ echo "== $(date -u +%T) DrAC colour jitter, K = 13, alone" | tee -a "$OUT/rates.
 speed 150 --packs 13 --json "$OUT/rates.jsonl" | tee -a "$OUT/rates.log" | tail -3
 echo "== $(date -u +%T) DrAC colour jitter, K = 5, two processes on the GPU at once" | tee -a "$OUT/rates.log"
 for i in 1 2; do
-  speed 180 --packs 5 --iterations 8 --json "$OUT/rates_pair$i.jsonl" >"$OUT/rates_pair$i.log" 2>&1 &
+  speed 180 --packs 5 --json "$OUT/rates_pair$i.jsonl" >"$OUT/rates_pair$i.log" 2>&1 &
 done
 wait
 tail -n 3 "$OUT"/rates_pair*.log | tee -a "$OUT/rates.log"

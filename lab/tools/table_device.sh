@@ -22,8 +22,9 @@
 # call at once and is named, for the next call. Every call also brings home the unfinished runs' logs so far
 # ($OUT/runs_so_far.tar.gz, one file of MAX_FILES): what the runner has not finished when the lease ends goes with
 # the machine, but not its evaluations up to the last call. The device gives a machine back 30 s after a call
-# returns: make the next call at once, or the runner and every unfinished run go with the machine. A task index names the same runs in every lease (kage.bench.tasks), and DIR must be the same path
-# in every lease, since bench.json records it. COMMIT names the tree's commit (the machine gets no .git) for the
+# returns: make the next call at once, or the runner and every unfinished run go with the machine. A task index
+# names the same runs in every lease (kage.bench.tasks), and DIR must be the same path in every lease, since
+# bench.json records it. COMMIT names the tree's commit (the machine gets no .git) for the
 # packs' provenance, beside the device, the command (each call that started the runner, which trained the
 # task), the call that packed it, and when it was trained and packed. Run with carry [".deps"]:
 #   COMMIT=$(git rev-parse --short HEAD) GPUS=all PACK=6 bash lab/tools/table_device.sh
