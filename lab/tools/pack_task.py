@@ -9,22 +9,27 @@ TASK `new` packs every finished task that this DIR has not packed before (DIR/pa
 runner of all tasks (`kage.bench run --gpus`) whose tasks finish while it runs: finished there means that the
 runner has also marked each run done (bench_state.json), since until its trainer exits it rewrites that file
 every 30 s, and a file rewritten between the archive and its checksum would not match on unpacking. With
-MAX_FILES (the device machine's limit on the files a call brings back), `new` packs only as many tasks as
-leave DEST within it, names the finished tasks it left for the next call, and exits with status 3
+MAX_FILES (the device machine's limit on the files a call brings back), `new` packs a task as its two files
+while they fit, then the rest into one file, DEST/more_tasks.tar (each task's two files; `tar xf` it into the
+packs folder at home), since the call that finds the runner ended may be the lease's last; only when not even
+that fits does it name the finished tasks it left for the next call and exit with status 3
 (LEFT_FOR_NEXT_CALL), so that the call can end at once and the next bring them home before the lease ends.
 
 usage: python3 lab/tools/pack_task.py DIR TASK|new DEST [MAX_FILES]"""
 import hashlib
 import json
 import os
+import shutil
 import sys
 import tarfile
+import tempfile
 import time
 
 PROVENANCE = "KAGE_PACK_PROVENANCE"
 TOP = ("bench.json", "suite.json", "tasks.json")
 LEFT_OUT = ("checkpoints", "tensorboard")
 LEFT_FOR_NEXT_CALL = 3
+BUNDLE = "more_tasks.tar"
 
 
 def sha256(path: str) -> str:
@@ -110,6 +115,21 @@ def pack(root: str, task: int, dest: str) -> None:
     print(f"pack_task: task {task}: {len(files)} files, {os.path.getsize(archive) / 1e6:.1f} MB in {archive}")
 
 
+def bundle(root: str, task: int, dest: str) -> None:
+    """Packs the task into DEST/more_tasks.tar beside the tasks already there, replacing it whole, so that a
+    killed call leaves the previous bundle intact."""
+    path = os.path.join(dest, BUNDLE)
+    with tempfile.TemporaryDirectory() as staging:
+        pack(root, task, staging)
+        if os.path.exists(path):
+            shutil.copyfile(path, path + ".part")
+        with tarfile.open(path + ".part", "a") as tar:
+            for name in (f"task_{task}.tar.gz", f"task_{task}.sha256"):
+                tar.add(os.path.join(staging, name), arcname=name)
+    os.replace(path + ".part", path)
+    print(f"pack_task: task {task} bundled in {path}")
+
+
 def pack_new(root: str, dest: str, max_files: int) -> list:
     """Packs the tasks newly finished; returns those finished but left for the next call."""
     if not os.path.exists(os.path.join(root, "tasks.json")):
@@ -123,10 +143,14 @@ def pack_new(root: str, dest: str, max_files: int) -> list:
         runs = task_runs(table, task)
         if os.path.exists(mark) or unfinished_runs(root, runs) or not marked_done(root, runs):
             continue
-        if os.path.isdir(dest) and len(os.listdir(dest)) + 2 > max_files:
+        used = len(os.listdir(dest)) if os.path.isdir(dest) else 0
+        if used + 2 <= max_files:
+            pack(root, task, dest)
+        elif used + 1 <= max_files or os.path.exists(os.path.join(dest, BUNDLE)):
+            bundle(root, task, dest)
+        else:
             left.append(str(task))
             continue
-        pack(root, task, dest)
         open(mark, "w").close()
     if left:
         print(f"pack_task: task(s) {', '.join(left)} finished but not packed: {dest} would pass the {max_files} "

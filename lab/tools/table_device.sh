@@ -15,11 +15,12 @@
 # Every call then waits until LIMIT seconds of the call have passed or the runner has ended, packing each task
 # as soon as all its runs have finished: its run data without checkpoints, in $OUT/task_I.tar.gz and
 # $OUT/task_I.sha256 (lab/tools/pack_task.py), so a call brings home what finished since the last; copy them
-# into results/kage-bench-table/packs at once. A call that finds no runner with tasks left (it failed, or the
+# into results/kage-bench-table/packs at once. Tasks past the file limit come in one file, $OUT/more_tasks.tar:
+# `tar xf` it into the packs folder. A call that finds no runner with tasks left (it failed, or the
 # first call's ended) starts one again, which resumes the runs from their checkpoints. $OUT holds at most
 # MAX_FILES (the device's limit on the files a call brings back): the call's log, $OUT/call.log (the build's
-# lines, then the runner's since the last call), and as many tasks as fit; a finished task left over ends the
-# call at once and is named, for the next call. Every call also brings home the unfinished runs' logs so far
+# lines, then the runner's since the last call), and the tasks, the last ones bundled; a finished task left over
+# even so ends the call at once and is named, for the next call. Every call also brings home the unfinished runs' logs so far
 # ($OUT/runs_so_far.tar.gz, one file of MAX_FILES): what the runner has not finished when the lease ends goes with
 # the machine, but not its evaluations up to the last call. The device gives a machine back 30 s after a call
 # returns: make the next call at once, or the runner and every unfinished run go with the machine. A task index

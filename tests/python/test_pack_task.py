@@ -108,3 +108,27 @@ def test_an_unfinished_task_is_refused_by_its_runs(tmp_path):
                             capture_output=True, text=True)
     assert result.returncode != 0
     assert "task 0 is not finished: no summary.json in runs/a/1/seed_2" in result.stderr
+
+
+def test_new_bundles_what_passes_the_file_limit_in_one_file(tmp_path):
+    root = benchmark(tmp_path / "bench")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "call.log").write_text("")
+    result = pack_new(root, out, 4)  # the log, task 0's two files, one more
+    assert result.returncode == 0, result.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["call.log", "more_tasks.tar", "task_0.sha256", "task_0.tar.gz"]
+    with tarfile.open(out / "more_tasks.tar") as tar:
+        assert sorted(tar.getnames()) == ["task_1.sha256", "task_1.tar.gz", "task_2.sha256", "task_2.tar.gz"]
+        tar.extractall(tmp_path / "packs", filter="data")  # as the packs folder gathers them at home
+    for path in out.glob("task_*"):
+        path.rename(tmp_path / "packs" / path.name)
+    unpack = subprocess.run([sys.executable, str(UNPACK), str(tmp_path / "packs"), str(tmp_path / "home")],
+                            capture_output=True, text=True)
+    assert unpack.returncode == 0, unpack.stderr
+    for task in TASKS:
+        for unit, seed in task:
+            metrics = f"runs/{unit}/seed_{seed}/metrics.jsonl"
+            assert (tmp_path / "home" / metrics).read_text() == (root / metrics).read_text()
+    assert pack_new(root, tmp_path / "next_call", 4).returncode == 0  # nothing left to pack
+    assert not (tmp_path / "next_call").exists() or not list((tmp_path / "next_call").iterdir())
