@@ -30,6 +30,11 @@ def block_of(readme) -> str:
     return generated_block.generated(readme.read_text(), methods_tables.TOOL, str(readme))
 
 
+def section(block: str, heading: str) -> str:
+    """The part of `block` from its `### heading` to the next heading."""
+    return block.split(f"### {heading}", 1)[1].split("\n### ", 1)[0]
+
+
 def row(block: str, *first_cells: str) -> list:
     """The cells of the one table row of `block` that begins with `first_cells`."""
     found = [line for line in block.splitlines() if line.startswith("| " + " | ".join(first_cells) + " |")]
@@ -64,7 +69,8 @@ def test_the_readme_tables_are_those_of_the_packs_now():
     for method in methods:
         cells = row(block, "all pairs", method)
         assert int(cells[3]) > 0 and re.fullmatch(r"\d\.\d\d \[\d\.\d\d, \d\.\d\d\]", cells[6]), cells
-        assert row(block, method)[3] != "0", f"{method} has no training run in the tables"
+        assert row(section(block, "Training runs"), method)[3] != "0", f"{method} has no training run in the tables"
+        assert float(row(section(block, "GPU time"), method)[2]) > 0, f"{method} has no training time in the tables"
 
 
 # ---- the tool, on a stand-in method ----
@@ -114,8 +120,16 @@ def test_the_tables_of_a_stand_in_method(tmp_path):
     for axis in ("filters", "effects", "layout"):  # no stand-in run is scored there
         assert row(block, axis, "copy")[2:] == ["0", "0", "-", "-", "-"]
     # 2 run units x seeds 1-5; the baseline's 45 runs of seeds 1-5 include them
-    assert row(block, "copy")[1:4] == [f"{len(pairs)} of 34", f"{5 * len(pairs)} of 170", "10"]
-    assert row(block, "baseline")[1:4] == ["34 of 34", "170 of 170", "45"]
+    training = section(block, "Training runs")
+    assert row(training, "copy")[1:4] == [f"{len(pairs)} of 34", f"{5 * len(pairs)} of 170", "10"]
+    assert row(training, "baseline")[1:4] == ["34 of 34", "170 of 170", "45"]
+    # GPU time: one row per pack the two tasks hold, a part of the baseline's, on the devices their lists name
+    lists = [(BASELINE_PACKS / f"task_{task}.sha256").read_text().splitlines() for task in STAND_IN_TASKS]
+    packs = sum(1 for lines in lists for line in lines if re.search(r"  packs/task_\d+_pack_\d+\.json$", line))
+    named = sorted({line[len("# device: "):] for lines in lists for line in lines if line.startswith("# device: ")})
+    cost, baseline_cost = row(section(block, "GPU time"), "copy"), row(section(block, "GPU time"), "baseline")
+    assert cost[1] == str(packs) and cost[5] == "; ".join(named)
+    assert 0 < float(cost[2]) < float(baseline_cost[2]) and 0 < float(cost[3]) < float(baseline_cost[3])
 
     again = tool("--methods-root", root, "--check")
     assert again.returncode == 0, again.stdout + again.stderr
