@@ -22,6 +22,10 @@ def test_references_are_checked_with_their_fix():
         plugins.load("kage.ppo.agent:nature_cnnn", "--agent")
     with pytest.raises(SystemExit, match="has no 'xyz'; it defines TinyNet, make, wrong_shape"):
         plugins.load("lone_agent:xyz", "--agent")
+    # A module's __all__ is what it offers: the shipped set's helpers are not named as augmentations.
+    with pytest.raises(SystemExit, match="has no 'xyz'; it defines random_shift, random_crop, color_jitter, grayscale, "
+                                         "random_conv, cutout_color, gaussian_noise, overlay$"):
+        plugins.load_augment("kage.ppo.augment:xyz")
     with pytest.raises(SystemExit, match=r"must take \(obs, uniform\)"):
         plugins.load_augment("math:sqrt")
 

@@ -58,8 +58,9 @@ def load(reference: str, flag: str) -> Callable:
                          "that holds it on PYTHONPATH") from None
     found = getattr(module, attribute, None)
     if not callable(found):
-        names = [n for n, v in vars(module).items() if callable(v) and not n.startswith("_")
-                 and getattr(v, "__module__", None) == module.__name__]
+        names = list(getattr(module, "__all__", None) or  # the module's own list of what it offers, else its functions
+                     [n for n, v in vars(module).items() if callable(v) and not n.startswith("_")
+                      and getattr(v, "__module__", None) == module.__name__])
         what = "has no" if found is None else "has a non-callable"
         close = difflib.get_close_matches(attribute, names, n=1)
         hint = f"did you mean '{close[0]}'?" if close else f"it defines {', '.join(names) or 'no functions'}"
