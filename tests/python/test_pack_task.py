@@ -45,6 +45,16 @@ def pack_new(root, dest, max_files):
                           env={**os.environ, "KAGE_PACK_PROVENANCE": "device: test"})
 
 
+def assert_unpacks_to_the_runs(packs, home, root):
+    """table_unpack.py unpacks the folder of packs into `home` with every run's metrics as in `root`."""
+    unpack = subprocess.run([sys.executable, str(UNPACK), str(packs), str(home)], capture_output=True, text=True)
+    assert unpack.returncode == 0, unpack.stderr
+    for task in TASKS:
+        for unit, seed in task:
+            metrics = f"runs/{unit}/seed_{seed}/metrics.jsonl"
+            assert (home / metrics).read_text() == (root / metrics).read_text()
+
+
 def test_new_packs_what_fits_and_ends_with_status_3_for_the_rest(tmp_path):
     root = benchmark(tmp_path / "bench")
     out = tmp_path / "out"
@@ -80,13 +90,7 @@ def test_new_packs_what_fits_and_ends_with_status_3_for_the_rest(tmp_path):
     packs.mkdir()
     for path in [*out.glob("task_*"), *(tmp_path / "next_call").glob("task_*")]:
         path.rename(packs / path.name)
-    unpack = subprocess.run([sys.executable, str(UNPACK), str(packs), str(tmp_path / "home")],
-                            capture_output=True, text=True)
-    assert unpack.returncode == 0, unpack.stderr
-    for task in TASKS:
-        for unit, seed in task:
-            metrics = f"runs/{unit}/seed_{seed}/metrics.jsonl"
-            assert (tmp_path / "home" / metrics).read_text() == (root / metrics).read_text()
+    assert_unpacks_to_the_runs(packs, tmp_path / "home", root)
 
 
 def test_new_waits_until_the_runner_marks_the_runs_done(tmp_path):
@@ -123,12 +127,6 @@ def test_new_bundles_what_passes_the_file_limit_in_one_file(tmp_path):
         tar.extractall(tmp_path / "packs", filter="data")  # as the packs folder gathers them at home
     for path in out.glob("task_*"):
         path.rename(tmp_path / "packs" / path.name)
-    unpack = subprocess.run([sys.executable, str(UNPACK), str(tmp_path / "packs"), str(tmp_path / "home")],
-                            capture_output=True, text=True)
-    assert unpack.returncode == 0, unpack.stderr
-    for task in TASKS:
-        for unit, seed in task:
-            metrics = f"runs/{unit}/seed_{seed}/metrics.jsonl"
-            assert (tmp_path / "home" / metrics).read_text() == (root / metrics).read_text()
+    assert_unpacks_to_the_runs(tmp_path / "packs", tmp_path / "home", root)
     assert pack_new(root, tmp_path / "next_call", 4).returncode == 0  # nothing left to pack
     assert not (tmp_path / "next_call").exists() or not list((tmp_path / "next_call").iterdir())
