@@ -278,11 +278,7 @@ class GpuEnv final : public Env {
     return bind(e) && no_pending_error(e) && batch_.reset(seeds, mask, e) && (started_ = true) && succeeded();
   }
   bool step(const Actions& a, std::string* e) override {
-    last_error_kind_ = ErrorKind::kUsage;
-    const std::string problem = unstarted_problem(started_, true, nullptr, batch_.size());
-    if (!problem.empty()) return fail(e, problem);
-    last_error_kind_ = ErrorKind::kOther;
-    if (!bind(e) || !no_pending_error(e)) return false;
+    if (!ready_to_step(e)) return false;
     if (a.memory == Memory::kDevice) {
       if (a.dtype != DType::kInt32 && a.dtype != DType::kInt64) return fail(e, "kage: actions must be int32 or int64");
       return batch_.step(DeviceActions{reinterpret_cast<CUdeviceptr>(a.data), a.stride, a.dtype == DType::kInt64}, e) &&
@@ -326,6 +322,19 @@ class GpuEnv final : public Env {
     return bind(e) && (batch_.load_state(data, size, hash_, e) || fail(e, "kage: load_state: " + *e)) &&
            (started_ = true);
   }
+
+  /// What a step checks before it launches: started, the context bound, no action error reported.
+  bool ready_to_step(std::string* e) {
+    last_error_kind_ = ErrorKind::kUsage;
+    const std::string problem = unstarted_problem(started_, true, nullptr, batch_.size());
+    if (!problem.empty()) return fail(e, problem);
+    last_error_kind_ = ErrorKind::kOther;
+    return bind(e) && no_pending_error(e);
+  }
+  /// The device batch, for step_together; stepped() marks a step of it (run there) as the last call's success.
+  DeviceBatch& device_batch() { return batch_; }
+  CUcontext context() const { return ctx_; }
+  void stepped() { succeeded(); }
 
  private:
   /// Makes the batch's context current: the driver API acts on the calling thread's context, and the
@@ -389,7 +398,8 @@ std::unique_ptr<Env> open_gpu_parts(std::vector<GpuEnvPart> parts, const std::st
   std::vector<DevicePartSource> sources;
   for (size_t k = 0; k < parts.size(); ++k) {
     const LoweredConfig& c = parts[k].loaded->config;
-    sources.push_back(DevicePartSource{&modules[k], c.latent, c.visual, parts[k].pack.view(), parts[k].num_envs});
+    sources.push_back(DevicePartSource{&modules[k], c.latent, c.visual, parts[k].pack.view(), parts[k].num_envs,
+                                       parts[k].loaded->spec_hash});
   }
   auto b = DeviceBatch::create(sources, error);
   if (!b) return nullptr;
@@ -625,6 +635,39 @@ std::optional<KernelsCompiled> compile_kernels(const std::vector<std::string>& p
   }
   *kind = ErrorKind::kNone;
   return done;
+#endif
+}
+
+bool step_together(const std::vector<Env*>& envs, const Actions& actions, int64_t row_stride, std::string* error,
+                   int64_t* failed) {
+  int64_t ignored = -1;
+  int64_t& at = failed ? *failed : ignored;
+  at = -1;
+  if (envs.empty()) return fail(error, "kage::step_together: no batches");
+  if (actions.memory != Memory::kDevice) return fail(error, "kage::step_together: actions must be in device memory");
+  if (actions.dtype != DType::kInt32 && actions.dtype != DType::kInt64)
+    return fail(error, "kage: actions must be int32 or int64");
+#if defined(KAGE_API_HAVE_CUDA)
+  std::vector<GpuEnv*> gpu;
+  for (size_t i = 0; i < envs.size(); ++i) {
+    auto* g = dynamic_cast<GpuEnv*>(envs[i]);
+    if (!g) return at = static_cast<int64_t>(i), fail(error, "kage::step_together: the batch runs on the CPU");
+    if (!gpu.empty() && g->context() != gpu.front()->context())
+      return at = static_cast<int64_t>(i), fail(error, "kage::step_together: the batch is on another GPU context");
+    gpu.push_back(g);
+  }
+  std::vector<DeviceBatch*> batches;
+  for (size_t i = 0; i < gpu.size(); ++i) {
+    if (!gpu[i]->ready_to_step(error)) return at = static_cast<int64_t>(i), false;
+    batches.push_back(&gpu[i]->device_batch());
+  }
+  const ActionRows rows{actions.data, row_stride, actions.stride, actions.dtype == DType::kInt64 ? 1 : 0};
+  if (!DeviceBatch::step_together(batches, rows, error)) return false;
+  for (GpuEnv* g : gpu) g->stepped();
+  return true;
+#else
+  (void)row_stride;
+  return at = 0, fail(error, "kage::step_together: the batch runs on the CPU");
 #endif
 }
 

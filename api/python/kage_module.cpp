@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 
 #include <memory>
+#include <algorithm>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -181,8 +182,34 @@ class PyEnv {
     if (!problem.empty()) raise_value_error(problem);
   }
 
-  /// kage::python::step_rows over these batches, each stepped by its own step; a failure names its batch.
+  /// kage::python::step_rows over these batches: host rows each by its batch's own step, device rows by
+  /// kage::step_together with every batch's lock held; a failure names its batch.
   static void step_rows(const std::vector<PyEnv*>& envs, const py::object& actions) {
+    auto together = [&envs](const kage::Actions& first_row, int64_t row_stride) {
+      Outcome o;
+      {
+        py::gil_scoped_release release;
+        // Every batch's lock, taken in one order by every caller (the address of the lock), so two calls
+        // on other threads never deadlock; a batch listed twice is refused by kage.step_batches first.
+        std::vector<std::mutex*> mutexes;
+        for (PyEnv* env : envs) mutexes.push_back(env->mutex_.get());
+        std::sort(mutexes.begin(), mutexes.end());
+        std::vector<std::unique_lock<std::mutex>> held;
+        for (std::mutex* m : mutexes) held.emplace_back(*m);
+        std::vector<kage::Env*> batches;
+        for (PyEnv* env : envs) {
+          if (!env->env_) throw std::runtime_error("this environment is closed: make a new one with kage.make_vec");
+          batches.push_back(env->env_.get());
+        }
+        int64_t failed = -1;
+        o.ok = kage::step_together(batches, first_row, row_stride, &o.error, &failed);
+        if (!o.ok && failed >= 0) {
+          o.kind = batches[static_cast<size_t>(failed)]->last_error_kind();
+          o.error = kage::python::together_failure(static_cast<size_t>(failed), batches.size(), o.error);
+        }
+      }
+      raise_if_failed(o);
+    };
     std::vector<kage::python::RowBatch> batches;
     for (PyEnv* env : envs) {
       auto step = [env, rows = envs.size()](size_t row, const kage::Actions& a) {
@@ -191,10 +218,10 @@ class PyEnv {
         raise_if_failed(o);
       };
       batches.push_back(env->locked([&](kage::Env& e) {  // one lock a batch: this runs every step
-        return kage::python::RowBatch{e.num_envs(), e.backend() == kage::Backend::kGpu, e.stream(), step};
+        return kage::python::RowBatch{e.num_envs(), e.backend() == kage::Backend::kGpu, step};
       }));
     }
-    kage::python::step_rows(batches, actions);
+    kage::python::step_rows(batches, actions, together);
   }
 
   py::bytes save_state() const {

@@ -1,14 +1,11 @@
-// kage._kage.step_rows: checks the actions array against the batches, orders the batches' streams, then
-// steps each batch by its row.
+// kage._kage.step_rows: checks the actions array against the batches, then steps each batch by its row (host
+// actions) or every batch at once (device actions).
 #include "api/python/step_rows.h"
 
 #include <dlpack/dlpack.h>
 #include <pybind11/numpy.h>
 
-#include <algorithm>
-#include <stdexcept>
 
-#include "api/python/cuda_streams.h"
 #include "api/python/device_array.h"
 
 namespace py = pybind11;
@@ -55,30 +52,17 @@ std::string device_rows_problem(const std::vector<RowBatch>& batches, const DLTe
   return "";
 }
 
-/// Makes every batch's stream wait for what batches[0]'s stream has queued so far (the actions' producer).
-void order_streams_after_first(const std::vector<RowBatch>& batches) {
-  std::vector<void*> ordered{batches[0].stream};
-  for (const RowBatch& b : batches) {
-    if (std::find(ordered.begin(), ordered.end(), b.stream) != ordered.end()) continue;
-    std::string error;
-    if (!order_after(batches[0].stream, b.stream, &error)) throw std::runtime_error(error);
-    ordered.push_back(b.stream);
-  }
-}
-
-void step_device_rows(const std::vector<RowBatch>& batches, const DLTensor& d) {
-  const int64_t item = d.dtype.bits / 8, row_stride = d.strides ? d.strides[0] : d.shape[1];
+void step_device_rows(const DLTensor& d, const StepTogether& together) {
+  const int64_t row_stride = d.strides ? d.strides[0] : d.shape[1];
   const int64_t stride = d.strides ? d.strides[1] : 1;
-  const char* data = static_cast<const char*>(d.data) + d.byte_offset;
-  order_streams_after_first(batches);
-  for (size_t i = 0; i < batches.size(); ++i)
-    batches[i].step(i, Actions{data + static_cast<int64_t>(i) * row_stride * item, Memory::kDevice,
-                               item == 8 ? DType::kInt64 : DType::kInt32, stride});
+  together(Actions{static_cast<const char*>(d.data) + d.byte_offset, Memory::kDevice,
+                   d.dtype.bits == 64 ? DType::kInt64 : DType::kInt32, stride},
+           row_stride);
 }
 
 }  // namespace
 
-void step_rows(const std::vector<RowBatch>& batches, const py::object& actions) {
+void step_rows(const std::vector<RowBatch>& batches, const py::object& actions, const StepTogether& together) {
   if (batches.empty()) throw py::value_error("step_rows: no batches");
   const int32_t n = batches[0].num_envs;
   for (size_t i = 0; i < batches.size(); ++i)
@@ -91,7 +75,7 @@ void step_rows(const std::vector<RowBatch>& batches, const py::object& actions) 
   const std::string problem = device_rows_problem(batches, t->dl_tensor, n);
   PyCapsule_SetName(actions.ptr(), "used_dltensor");  // ours now: freed below, after the launches
   try {
-    if (problem.empty()) step_device_rows(batches, t->dl_tensor);
+    if (problem.empty()) step_device_rows(t->dl_tensor, together);
   } catch (...) {
     if (t->deleter) t->deleter(t);
     throw;
@@ -100,13 +84,26 @@ void step_rows(const std::vector<RowBatch>& batches, const py::object& actions) 
   if (!problem.empty()) throw py::value_error(problem);
 }
 
-std::string row_failure(size_t row, size_t rows, const std::string& error) {
-  const std::string which = "batch " + std::to_string(row) + " of " + std::to_string(rows) +
-                            (row == 0 ? " (none stepped)" : " (the " + std::to_string(row) +
-                                                                " before it stepped, the rest did not)");
+namespace {
+
+/// `error` led by `which` batch failed (after kage's own "kage: " prefix, when it has one).
+std::string batch_failure(const std::string& which, const std::string& error) {
   const std::string lead = "kage: ";
   if (error.compare(0, lead.size(), lead) == 0) return lead + which + ": " + error.substr(lead.size());
   return which + ": " + error;
+}
+
+}  // namespace
+
+std::string row_failure(size_t row, size_t rows, const std::string& error) {
+  return batch_failure("batch " + std::to_string(row) + " of " + std::to_string(rows) +
+                           (row == 0 ? " (none stepped)"
+                                     : " (the " + std::to_string(row) + " before it stepped, the rest did not)"),
+                       error);
+}
+
+std::string together_failure(size_t row, size_t rows, const std::string& error) {
+  return batch_failure("batch " + std::to_string(row) + " of " + std::to_string(rows) + " (none stepped)", error);
 }
 
 }  // namespace kage::python

@@ -193,6 +193,17 @@ struct MixturePart {
 std::unique_ptr<Env> open_mixture(const std::vector<MixturePart>& parts, const Options& options, std::string* error,
                                   ErrorKind* kind = nullptr);
 
+/// Steps envs[i] by row i of the device array `actions` (element i * row_stride + env * actions.stride), as
+/// envs[i]->step(row i) would, byte for byte, with one step launch and one render launch per config over every
+/// batch that runs it (a pack's runs of one config, a mixture's parts across runs) instead of a launch pair per
+/// batch and mixture part: for a learner that steps many small batches every step. GPU batches of one context,
+/// each started; ordered on envs[0]'s stream after the work queued so far on the others' streams, which are
+/// ordered after the step. A refusal steps nothing and puts the index of the batch it is about in `failed` (-1:
+/// none): a batch on the CPU or not started, or an out-of-range action an earlier step of it reported (that
+/// batch's last_error_kind() is then kAction).
+[[nodiscard]] bool step_together(const std::vector<Env*>& envs, const Actions& actions, int64_t row_stride,
+                                 std::string* error, int64_t* failed = nullptr);
+
 /// What compile_kernels did: how many configs' kernels NVRTC compiled, and how many the kernel cache held.
 struct KernelsCompiled {
   int32_t compiled = 0;

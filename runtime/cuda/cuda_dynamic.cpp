@@ -88,6 +88,7 @@ KAGE_CU_FORWARD(cuStreamCreate, (CUstream * s, unsigned int flags), (s, flags))
 KAGE_CU_FORWARD(cuStreamDestroy, (CUstream s), (s))
 KAGE_CU_FORWARD(cuStreamSynchronize, (CUstream s), (s))
 KAGE_CU_FORWARD(cuStreamWaitEvent, (CUstream s, CUevent e, unsigned int flags), (s, e, flags))
+KAGE_CU_FORWARD(cuThreadExchangeStreamCaptureMode, (CUstreamCaptureMode * mode), (mode))
 KAGE_CU_FORWARD(cuLaunchKernel,
                 (CUfunction f, unsigned gx, unsigned gy, unsigned gz, unsigned bx, unsigned by, unsigned bz,
                  unsigned smem, CUstream s, void** params, void** extra),

@@ -2,11 +2,13 @@
 #include "runtime/cuda/device_batch.h"
 
 #include <algorithm>
+#include <atomic>
 #include <climits>
 #include <cstddef>
 #include <cstring>
 #include <vector>
 
+#include "runtime/cuda/group_plan.h"
 #include "runtime/cuda/render_plan.h"
 #include "runtime/cpu/batch_state.h"
 #include "runtime/latent/latent_state.h"
@@ -221,7 +223,7 @@ std::optional<DeviceBatch> DeviceBatch::create(const CudaModule& module, const L
     *error = "DeviceBatch: the environment count must be positive";
     return std::nullopt;
   }
-  return create({DevicePartSource{&module, lp, vp, host_assets, num_envs}}, error);
+  return create({DevicePartSource{&module, lp, vp, host_assets, num_envs, {}}}, error);
 }
 
 std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSource>& parts, std::string* error) {
@@ -255,25 +257,34 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
 
   // Each part: its kernels, its parameters in its module, its launch settings and its assets. A part is
   // kept in the batch as soon as it owns device memory, so that the batch's destructor frees it on error.
+  static std::atomic<uint64_t> batches_made{0};
   DeviceBatch b;
+  b.serial_ = ++batches_made;
+  b.multiprocessors_ = multiprocessors;
   int32_t first = 0;
   int32_t visual_extent = 0;
   for (const DevicePartSource& src : parts) {
     Part p;
     p.first = first;
-    for (auto [fn, name] : {std::pair{&p.reset, "kage_reset"}, std::pair{&p.step, "kage_step"}, std::pair{&p.render, "kage_render"}}) {
+    for (auto [fn, name] : {std::pair{&p.reset, "kage_reset"}, std::pair{&p.step, "kage_step"},
+                            std::pair{&p.render, "kage_render"}, std::pair{&p.step_rows, "kage_step_rows"},
+                            std::pair{&p.render_rows, "kage_render_rows"}}) {
       *fn = src.module->function(name, error);
       if (!*fn) return std::nullopt;
     }
     if (!b.sample_actions_ && !(b.sample_actions_ = src.module->function("kage_sample_actions", error)))
       return std::nullopt;
     if (!upload_dynamic_params(*src.module, src.lp, src.vp, error)) return std::nullopt;
+    size_t dynamic_bytes = 0;
+    if (src.module->global("kage_dynamic_latent", &dynamic_bytes) == 0) p.code = src.code;
+    p.frame_passes = needs_frame_passes(src.vp);
     p.render_threads = render_threads(src.vp);
     p.render_smem = render_dynamic_smem_bytes(src.vp);
     p.frames_per_block = frames_per_block(src.vp, std::max(src.num_envs, 1), multiprocessors);
-    if (!check(cuFuncSetAttribute(p.render, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, p.render_smem),
-               "cuFuncSetAttribute(dynamic shared memory)", error))
-      return std::nullopt;
+    for (CUfunction render : {p.render, p.render_rows})
+      if (!check(cuFuncSetAttribute(render, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, p.render_smem),
+                 "cuFuncSetAttribute(dynamic shared memory)", error))
+        return std::nullopt;
     std::optional<DeviceAssets> assets = upload_assets(src.host_assets, error);
     if (!assets) return std::nullopt;
     p.assets = assets->memory;
@@ -370,7 +381,10 @@ DeviceBatch::DeviceBatch(DeviceBatch&& o) noexcept
       seeds_(std::move(o.seeds_)),
       action_error_(o.action_error_),
       sample_actions_(o.sample_actions_),
-      fork_(o.fork_) {
+      fork_(o.fork_),
+      serial_(o.serial_),
+      multiprocessors_(o.multiprocessors_),
+      plans_(std::move(o.plans_)) {
   o.parts_.clear();
   o.state_ = o.obs_buf_ = o.step_counts_ = 0;
   o.action_error_ = nullptr;
@@ -379,6 +393,7 @@ DeviceBatch::DeviceBatch(DeviceBatch&& o) noexcept
 
 DeviceBatch::~DeviceBatch() {
   // Frees fail only once the context is gone at exit, when the memory is released anyway.
+  plans_.clear();
   for (CUdeviceptr p : {state_, obs_buf_, step_counts_})
     if (p) cuMemFree(p);
   for (const Part& p : parts_) {

@@ -13,6 +13,7 @@
 #include <cuda.h>
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,7 +60,12 @@ struct DevicePartSource {
   VisualParams vp{};
   AssetView host_assets{};
   int32_t num_envs = 0;
+  /// What the module's code is (its config's Spec hash): parts of one code in several batches step in one
+  /// launch (step_together). Empty, or a generic module (parameters in __constant__ memory): never shared.
+  std::string code;
 };
+
+struct GroupPlan;
 
 class DeviceBatch {
  public:
@@ -95,6 +101,13 @@ class DeviceBatch {
   bool step(const DeviceActions& actions, std::string* error);
   /// step() with the actions already in the batch's own buffer (actions()).
   bool step_device_actions(std::string* error);
+  /// Steps batches[i] by row i of `actions` (device memory), as batches[i]->step would, with one step launch
+  /// and one render launch per code over every part of every batch that runs it (a pack's runs of one
+  /// config, a mixture's parts across runs) instead of a launch pair per batch part. Launched on batches[0]'s
+  /// stream after the work queued so far on the others' streams, which are ordered after the step (the codes'
+  /// launches fork onto streams of their own and join back). The launches' plan is made at a list's first
+  /// call, outside any stream capture, and kept by batches[0]: later calls and CUDA graphs of them reuse it.
+  static bool step_together(const std::vector<DeviceBatch*>& batches, const ActionRows& actions, std::string* error);
   /// One step without rendering (observations are left as they were).
   bool step_no_render(std::string* error);
   /// Fills actions() (every environment of every part) with uniform random actions in [0, 8) for step t,
@@ -145,6 +158,10 @@ class DeviceBatch {
     CUfunction reset = nullptr;
     CUfunction step = nullptr;
     CUfunction render = nullptr;
+    CUfunction step_rows = nullptr;    ///< the grouped forms (step_together)
+    CUfunction render_rows = nullptr;
+    std::string code;                  ///< DevicePartSource::code; empty for a generic module
+    bool frame_passes = false;         ///< needs_frame_passes of its config (one frame per rendering block)
     int32_t render_threads = 0;
     int32_t render_smem = 0;
     int32_t frames_per_block = 1;
@@ -163,6 +180,8 @@ class DeviceBatch {
   bool launch_renders(std::string* error);
   /// One step of every part reading `source` (element env * stride, env the batch's index), then renders.
   bool launch_step(const ActionSource& source, bool render, std::string* error);
+  /// The plan of step_together over `batches` (this batch first): found among plans_, or made.
+  GroupPlan* group_plan(const std::vector<DeviceBatch*>& batches, std::string* error);
   /// Queues the copies between the saved-state sections of `blob` and the device (to_host: download).
   bool copy_state(uint8_t* blob, bool to_host, std::string* error) const;
 
@@ -179,6 +198,9 @@ class DeviceBatch {
   ActionError* action_error_ = nullptr;  ///< host-mapped, one per part (its env is the part's index)
   CUfunction sample_actions_ = nullptr;  ///< the first part's (every module's is the same code)
   CUevent fork_ = nullptr;               ///< a mixture only: recorded on stream_, waited for by the parts' streams
+  uint64_t serial_ = 0;                  ///< this batch's number in the process: a plan names its batches by it
+  int32_t multiprocessors_ = 0;
+  std::vector<std::unique_ptr<GroupPlan>> plans_;  ///< step_together's plans led by this batch
 };
 
 }  // namespace kage

@@ -67,6 +67,22 @@ struct DeviceEnvs {
 
 static_assert(__is_trivially_copyable(DeviceEnvs), "DeviceEnvs is a kernel argument");
 
+/// One row of a grouped launch (DeviceBatch::step_together): a batch part that runs the launch's config.
+/// Block row blockIdx.y of kage_step_rows and kage_render_rows works on rows[blockIdx.y].
+struct GroupRow {
+  DeviceEnvs envs;  ///< the part's view, as its own launches see it (its count and report slots included)
+  int32_t batch;    ///< the row of the call's actions that holds this part's batch
+  int32_t first;    ///< the part's first environment in its batch
+};
+
+/// The actions of a grouped step: batch b's environment i reads element b * row_stride + i * stride.
+struct ActionRows {
+  const void* data;
+  int64_t row_stride;  ///< in elements
+  int64_t stride;      ///< in elements
+  int32_t is_int64;    ///< 0: int32 elements, 1: int64
+};
+
 /// Bytes of one environment's layout buffer: the segment count rounded up to whole 32-bit words.
 KAGE_HD int32_t segment_stride_bytes(int32_t segment_count) { return (segment_count + 3) / 4 * 4; }
 

@@ -160,6 +160,31 @@ __device__ __forceinline__ void render_body(const DeviceEnvs& e, BlockShared& sh
   }
 }
 
+/// A grouped step's row (blockIdx.y): copies the row into shared memory, points its actions at the batch's row
+/// of the call's array, then steps as step_body does and counts the launch in the part's own StepCount.
+template <class Cfg>
+__device__ __forceinline__ void step_row_body(const GroupRow* rows, const ActionRows& a, GroupRow& row) {
+  group_copy_words<BlockGroup>(&row, rows + blockIdx.y, static_cast<int32_t>(sizeof(GroupRow)));
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    const int64_t element = a.is_int64 ? 8 : 4;
+    row.envs.actions.data = static_cast<const uint8_t*>(a.data) + (row.batch * a.row_stride + row.first * a.stride) * element;
+    row.envs.actions.stride = a.stride;
+    row.envs.actions.is_int64 = a.is_int64;
+  }
+  __syncthreads();
+  step_body<Cfg>(row.envs);
+  count_step(row.envs.actions, row.envs.num_envs);
+}
+
+/// A grouped render's row (blockIdx.y): render_body over the row's part, its view copied into shared memory.
+template <class Cfg>
+__device__ __forceinline__ void render_row_body(const GroupRow* rows, GroupRow& row, BlockShared& sh, float* frame) {
+  group_copy_words<BlockGroup>(&row, rows + blockIdx.y, static_cast<int32_t>(sizeof(GroupRow)));
+  __syncthreads();
+  render_body<Cfg>(row.envs, sh, frame);
+}
+
 /// Uniform random actions in [0, 8) for step t (benchmarks), from their own key.
 __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n, uint64_t seed, uint32_t t) {
   const int32_t i = static_cast<int32_t>(blockIdx.x * blockDim.x + threadIdx.x);
@@ -171,7 +196,9 @@ __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n,
 /// Emits the entry points of one config with fixed unmangled names, so that a loader finds them in any
 /// compiled config: kage_reset and kage_step (one thread per environment; any block size),
 /// kage_render (render_threads() threads and render_dynamic_smem_bytes() bytes of dynamic shared memory
-/// per block, ceil(num_envs / grid) environments per block), kage_sample_actions. Use once per module.
+/// per block, ceil(num_envs / grid) environments per block), kage_sample_actions; and the grouped forms
+/// kage_step_rows and kage_render_rows, which run block row y of their grid on rows[y] (GroupRow): several
+/// batches' parts of this config in one launch. Use once per module.
 #define KAGE_INSTANTIATE_KERNELS(CFG)                                                                     \
   extern "C" __global__ void kage_reset(const kage::DeviceEnvs e) { kage::reset_body<CFG>(e); }           \
   extern "C" __global__ void kage_step(const kage::DeviceEnvs e) {                                        \
@@ -183,6 +210,17 @@ __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n,
     __shared__ kage::BlockShared sh;                                                                      \
     extern __shared__ float4 kage_frame[];                                                                \
     kage::render_body<CFG>(e, sh, reinterpret_cast<float*>(kage_frame));                                  \
+  }                                                                                                       \
+  extern "C" __global__ void kage_step_rows(const kage::GroupRow* rows, const kage::ActionRows actions) {       \
+    __shared__ kage::GroupRow row;                                                                        \
+    kage::step_row_body<CFG>(rows, actions, row);                                                         \
+  }                                                                                                       \
+  extern "C" __global__ void __launch_bounds__(kage::RenderBounds<CFG>::kThreads,                          \
+                                               kage::RenderBounds<CFG>::kMinBlocks) kage_render_rows(const kage::GroupRow* rows) { \
+    __shared__ kage::BlockShared sh;                                                                      \
+    __shared__ kage::GroupRow row;                                                                        \
+    extern __shared__ float4 kage_frame[];                                                                \
+    kage::render_row_body<CFG>(rows, row, sh, reinterpret_cast<float*>(kage_frame));                      \
   }                                                                                                       \
   extern "C" __global__ void kage_sample_actions(int32_t* actions, int32_t n, uint64_t seed, uint32_t t) {  \
     kage::sample_actions_body(actions, n, seed, t);                                                       \

@@ -78,11 +78,16 @@ KAGE_HD bool register_path_vectorized(const VisualParams& p) { return p.W % kPix
 /// Frames a rendering block renders, one after the other, for num_envs environments on
 /// `multiprocessors` SMs: one for the frame-pass path; on the register path up to
 /// kRegisterPathFramesPerBlock, fewer when the batch would then leave SMs short of resident blocks.
+/// `frame_passes`: needs_frame_passes of the config (frames_per_block below); a grouped launch
+/// (DeviceBatch::step_together) plans its several batches' environments as one batch.
 constexpr int32_t kRegisterPathBlocksPerSm = 16;
-KAGE_HD int32_t frames_per_block(const VisualParams& p, int32_t num_envs, int32_t multiprocessors) {
-  if (needs_frame_passes(p)) return 1;
+KAGE_HD int32_t frames_per_block(bool frame_passes, int32_t num_envs, int32_t multiprocessors) {
+  if (frame_passes) return 1;
   const int32_t fill = num_envs / maxi(1, multiprocessors * kRegisterPathBlocksPerSm);
   return mini(kRegisterPathFramesPerBlock, maxi(1, fill));
+}
+KAGE_HD int32_t frames_per_block(const VisualParams& p, int32_t num_envs, int32_t multiprocessors) {
+  return frames_per_block(needs_frame_passes(p), num_envs, multiprocessors);
 }
 
 /// Threads per rendering block.

@@ -1,7 +1,9 @@
 """kage.step_batches on the GPU: batches on streams of their own (as a pack's runs are), stepped by rows of one
 device actions tensor that the default stream writes, equal each batch stepped alone with its row, byte for
-byte, across autoresets; a mixture among them."""
+byte, across autoresets; a mixture among them. Device rows step with one launch pair per config over all the
+batches (kage::step_together); a refusal names its batch and steps none."""
 import numpy as np
+import pytest
 import torch
 
 import kage
@@ -64,3 +66,38 @@ def test_int32_rows_with_a_row_stride_step_as_int64_rows():
     torch.cuda.synchronize()
     for x, y in zip(a, b):
         assert np.array_equal(x.outputs()[0].numpy(), y.outputs()[0].numpy())
+
+
+def test_a_pack_of_mixtures_steps_together_as_each_alone():
+    """Eight runs of one mixture (a pack's runs on streams of their own, 40 environments: parts that do not fill
+    a warp) step with one launch pair per config over all eight: each batch equals its twin stepped alone."""
+    mixture = [SKELETON, FILTERS_5, str(BENCH / "filters/4-eval.yaml")]
+    streams = [torch.cuda.Stream().cuda_stream for _ in range(8)]
+    together = [kage.make_vec(mixture, 40, device="cuda", seed=i, stream=s) for i, s in enumerate(streams)]
+    alone = [kage.make_vec(mixture, 40, device="cuda", seed=i) for i in range(8)]
+    for env in together + alone:
+        env.reset()
+    generator = torch.Generator(device="cuda").manual_seed(7)
+    for step in range(520):
+        actions = torch.randint(0, 8, (8, 40), device="cuda", generator=generator, dtype=torch.int32)
+        kage.step_batches(together, actions)
+        for env, row in zip(alone, actions):
+            env.step(row)
+        torch.cuda.synchronize()
+        if step % 100 == 0 or step >= 495:
+            assert_same_outputs(together, alone, step)
+
+
+def test_a_bad_action_names_its_batch_and_nothing_steps():
+    envs = batches([0] * 4)
+    for env in envs:
+        env.reset()
+    actions = torch.zeros((4, N), dtype=torch.int64, device="cuda")
+    actions[2, 7] = 9  # batch 2 is the mixture: its first part's environment 7
+    kage.step_batches(envs, actions)  # step 1 runs with the value masked; the kernel reports it
+    torch.cuda.synchronize()
+    before = [outputs(env)["obs"] for env in envs]
+    with pytest.raises(ValueError, match=r"batch 2 of 4 \(none stepped\): .*step 1 held 9 for environment 7"):
+        kage.step_batches(envs, torch.zeros((4, N), dtype=torch.int64, device="cuda"))
+    torch.cuda.synchronize()
+    assert all(torch.equal(b, outputs(env)["obs"]) for b, env in zip(before, envs))
