@@ -275,8 +275,7 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
     if (!b.sample_actions_ && !(b.sample_actions_ = src.module->function("kage_sample_actions", error)))
       return std::nullopt;
     if (!upload_dynamic_params(*src.module, src.lp, src.vp, error)) return std::nullopt;
-    size_t dynamic_bytes = 0;
-    if (src.module->global("kage_dynamic_latent", &dynamic_bytes) == 0) p.code = src.code;
+    p.code = src.code;
     p.frame_passes = needs_frame_passes(src.vp);
     p.render_threads = render_threads(src.vp);
     p.render_smem = render_dynamic_smem_bytes(src.vp);

@@ -60,8 +60,9 @@ struct DevicePartSource {
   VisualParams vp{};
   AssetView host_assets{};
   int32_t num_envs = 0;
-  /// What the module's code is (its config's Spec hash): parts of one code in several batches step in one
-  /// launch (step_together). Empty, or a generic module (parameters in __constant__ memory): never shared.
+  /// What the module's code is (its config's Spec hash, for a specialized module): parts of one code in
+  /// several batches step in one launch (step_together). Empty (a generic module, whose parameters are its
+  /// own __constant__ memory): the part launches alone.
   std::string code;
 };
 
@@ -160,7 +161,7 @@ class DeviceBatch {
     CUfunction render = nullptr;
     CUfunction step_rows = nullptr;    ///< the grouped forms (step_together)
     CUfunction render_rows = nullptr;
-    std::string code;                  ///< DevicePartSource::code; empty for a generic module
+    std::string code;                  ///< DevicePartSource::code
     bool frame_passes = false;         ///< needs_frame_passes of its config (one frame per rendering block)
     int32_t render_threads = 0;
     int32_t render_smem = 0;

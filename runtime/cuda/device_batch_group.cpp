@@ -51,6 +51,7 @@ GroupPlan::~GroupPlan() {
     if (l.stream) cuStreamDestroy(l.stream);
   }
   for (CUevent e : queued) cuEventDestroy(e);
+  if (entered) cuEventDestroy(entered);
   if (fork) cuEventDestroy(fork);
   if (stepped) cuEventDestroy(stepped);
 }
@@ -105,7 +106,7 @@ GroupPlan* DeviceBatch::group_plan(const std::vector<DeviceBatch*>& batches, std
           !check(cuEventCreate(&l.done, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error))
         return nullptr;
   plan->queued.assign(batches.size(), nullptr);
-  for (CUevent* e : {&plan->fork, &plan->stepped})
+  for (CUevent* e : {&plan->entered, &plan->fork, &plan->stepped})
     if (!check(cuEventCreate(e, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error)) return nullptr;
   for (CUevent& e : plan->queued)
     if (!check(cuEventCreate(&e, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error)) return nullptr;
@@ -123,10 +124,14 @@ bool DeviceBatch::step_together(const std::vector<DeviceBatch*>& batches, const 
   GroupPlan* plan = lead.group_plan(batches, error);
   if (!plan) return false;
   const CUstream main = lead.stream_;
-  // After the work queued so far on every batch's stream (a consumer of its last outputs, its actions).
+  // After the work queued so far on every batch's stream (a consumer of its last outputs, its reset). The
+  // other streams first wait for the lead's (the actions' producer ordered itself before it): under a stream
+  // capture that brings them into the capture, whose streams may only wait for captured work.
+  if (!check(cuEventRecord(plan->entered, main), "cuEventRecord", error)) return false;
   for (size_t i = 1; i < batches.size(); ++i)
     if (batches[i]->stream_ != main &&
-        !(check(cuEventRecord(plan->queued[i], batches[i]->stream_), "cuEventRecord", error) &&
+        !(check(cuStreamWaitEvent(batches[i]->stream_, plan->entered, 0), "cuStreamWaitEvent", error) &&
+          check(cuEventRecord(plan->queued[i], batches[i]->stream_), "cuEventRecord", error) &&
           check(cuStreamWaitEvent(main, plan->queued[i], 0), "cuStreamWaitEvent", error)))
       return false;
   const bool fork = plan->launches.size() > 1;

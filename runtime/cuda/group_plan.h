@@ -28,6 +28,7 @@ struct GroupPlan {
   std::vector<uint64_t> serials;    ///< the batches' serial numbers, in call order
   CUdeviceptr rows = 0;             ///< owned: the GroupRow of every part with environments, code by code
   std::vector<GroupLaunch> launches;
+  CUevent entered = nullptr;        ///< owned: the lead stream on entry, waited for by the others' streams
   CUevent fork = nullptr;           ///< owned: recorded on the lead stream, waited for by the launches' streams
   std::vector<CUevent> queued;      ///< owned, one per batch: its stream's work before the step
   CUevent stepped = nullptr;        ///< owned: the step's end on the lead stream, waited for by the others
