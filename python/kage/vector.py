@@ -397,9 +397,12 @@ def step_batches(envs: Sequence[VecEnv], actions) -> None:
     the runtime: for a learner that steps many batches (a pack's runs, an evaluation's configs) every step, where
     one Python call per batch would cost more than the batches' kernels. ``actions``: [len(envs), num_envs]
     integers, host or GPU as ``step`` takes them; the batches must have one size. Read the outputs with
-    ``outputs()``, the views ``step`` returns. What ``step`` would refuse before stepping (a shape, a dtype, a
-    device) is refused before any batch steps; a batch whose own step fails (an action outside 0..7 in its row)
-    raises that error, naming the batch; the batches before it have stepped."""
+    ``outputs()``, the views ``step`` returns. Device actions step the GPU batches together: one step launch and
+    one render launch per config over every batch (and mixture part) that runs it, on ``envs[0]``'s stream, the
+    others' streams ordered before and after. What ``step`` would refuse before stepping (a shape, a dtype, a
+    device) is refused before any batch steps. A batch whose step fails (an action outside 0..7 in its row, or
+    reported by an earlier step of device actions) raises that error, naming the batch: with device actions no
+    batch has stepped, with host actions the batches before it have."""
     envs = list(envs)
     if not envs or not all(isinstance(env, VecEnv) for env in envs):
         raise TypeError("step_batches: a non-empty list of kage.VecEnv (from kage.make_vec)")

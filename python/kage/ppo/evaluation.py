@@ -128,12 +128,13 @@ def graphable(settings: EvalSettings, envs: List["kage.VecEnv"]) -> bool:
 
 
 class StepGraph:
-    """An evaluation's step replayed as one CUDA graph: the policy's kernels, every batch's step and render
-    launches, and the records' row, with one launch from the host per step instead of hundreds. The first call
-    steps eagerly (cuDNN and Triton choose their kernels outside the capture); the second captures the step,
-    which steps nothing, then replays it, as every later call does. The environments' launches are captured
-    on their own streams, forked from and joined to the capture's, so the batches still step side by side; a
-    batch numbers its step launches on the device, so an action's report names the replayed step."""
+    """An evaluation's step replayed as one CUDA graph: the policy's kernels, every config's step and render
+    launches over the batches, and the records' row, with one launch from the host per step instead of hundreds.
+    The first call steps eagerly (cuDNN and Triton choose their kernels outside the capture, and the batches'
+    launch plan is made); the second captures the step, which steps nothing, then replays it, as every later call
+    does. The configs' launches are captured on streams of their own, forked from and joined to the capture's, so
+    they still run side by side; a batch numbers its step launches on the device, so an action's report names the
+    replayed step."""
 
     def __init__(self, step):
         self.step, self.graph = step, None

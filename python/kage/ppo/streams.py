@@ -1,11 +1,12 @@
-"""Each run's environments on a CUDA stream of their own, so that the batches of a pack step at once.
+"""Each run's environments on a CUDA stream of their own, ordered against the learner.
 
-A run's batch is a few hundred environments (a mixture's parts fewer still): its step and render kernels are
-too small to fill the GPU and last about as long as a full one. On one stream a pack's K batches run one after
-another; on a stream per run they overlap (and a mixture's parts, each on a stream of the batch's own). A batch
-orders itself after the learner when it takes the actions (the DLPack protocol, kage.actions); the learner
-orders itself after the batches with `wait_for` before it reads their outputs, and the rest of the loop is
-unchanged. Under --cuda-graph the whole step is one graph (GraphedStep)."""
+A run's batch is a few hundred environments (a mixture's parts fewer still): its kernels alone would be too small
+to fill the GPU. A pack's step goes through kage.step_batches, which launches each config once over every run's
+batch (on the first run's stream; the other runs' streams are ordered before and after it), while a run's own
+work (a reset, a stage's entry, a saved state) queues on its stream. A batch orders itself after the learner when
+it takes the actions (the DLPack protocol, kage.actions); the learner orders itself after the batches with
+`wait_for` before it reads their outputs, and the rest of the loop is unchanged. Under --cuda-graph the whole
+step is one graph (GraphedStep)."""
 from typing import Iterable, List, Optional
 
 import torch
@@ -44,11 +45,11 @@ def release(streams: Iterable[Optional[torch.cuda.Stream]]) -> None:
 
 class GraphedStep:
     """`kage.step_batches(envs, actions)` and the learner's `wait_for` as one CUDA graph: one launch a step
-    instead of one or more per batch and per mixture part. Captured at the first call (the capture steps
-    nothing; the replay that follows does), and again when the batches or the actions' memory change (a
-    schedule's stage opens new batches). The batches' launches are captured on their own streams, forked from
-    the capture's and joined back, so they still run side by side; a batch numbers its steps on the device, so an
-    action's report names the replayed step. The replays run on the current stream: `release` the batches'
+    instead of a launch pair per config. Captured at the first call (the capture steps nothing; the replay that
+    follows does), and again when the batches or the actions' memory change (a schedule's stage opens new
+    batches). The configs' launches are captured on streams of their own, forked from the capture's and joined
+    back, so they still run side by side; a batch numbers its steps on the device, so an action's report names
+    the replayed step. The replays run on the current stream: `release` the batches'
     streams before queueing work on them directly."""
 
     def __init__(self):
