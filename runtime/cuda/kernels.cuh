@@ -168,7 +168,8 @@ __device__ __forceinline__ void step_row_body(const GroupRow* rows, const Action
   __syncthreads();
   if (threadIdx.x == 0) {
     const int64_t element = a.is_int64 ? 8 : 4;
-    row.envs.actions.data = static_cast<const uint8_t*>(a.data) + (row.batch * a.row_stride + row.first * a.stride) * element;
+    const int64_t at = row.batch * a.row_stride + row.first * a.stride;
+    row.envs.actions.data = static_cast<const uint8_t*>(a.data) + at * element;
     row.envs.actions.stride = a.stride;
     row.envs.actions.is_int64 = a.is_int64;
   }
@@ -211,12 +212,13 @@ __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n,
     extern __shared__ float4 kage_frame[];                                                                \
     kage::render_body<CFG>(e, sh, reinterpret_cast<float*>(kage_frame));                                  \
   }                                                                                                       \
-  extern "C" __global__ void kage_step_rows(const kage::GroupRow* rows, const kage::ActionRows actions) {       \
+  extern "C" __global__ void kage_step_rows(const kage::GroupRow* rows, const kage::ActionRows actions) {   \
     __shared__ kage::GroupRow row;                                                                        \
     kage::step_row_body<CFG>(rows, actions, row);                                                         \
   }                                                                                                       \
   extern "C" __global__ void __launch_bounds__(kage::RenderBounds<CFG>::kThreads,                          \
-                                               kage::RenderBounds<CFG>::kMinBlocks) kage_render_rows(const kage::GroupRow* rows) { \
+                                               kage::RenderBounds<CFG>::kMinBlocks)                       \
+      kage_render_rows(const kage::GroupRow* rows) {                                                      \
     __shared__ kage::BlockShared sh;                                                                      \
     __shared__ kage::GroupRow row;                                                                        \
     extern __shared__ float4 kage_frame[];                                                                \
