@@ -9,7 +9,7 @@ rm -rf .deps && mkdir -p .deps/debs
 (cd .deps/debs && apt-get download libyaml-cpp-dev libyaml-cpp0.7 libfmt-dev libfmt9 libstb-dev libstb0 \
   nlohmann-json3-dev libcli11-dev libdlpack-dev)
 for f in .deps/debs/*.deb; do dpkg -x "$f" .deps; done
-rm -rf .deps/debs
+rm -rf .deps/debs .deps/usr/share/doc  # the packages' documentation: a call's carry counts against its 64 MiB
 if [ -d /root/.pyenv/versions/3.12.1/include/python3.12 ]; then
   mkdir -p .deps/python3.12/include && cp -r /root/.pyenv/versions/3.12.1/include/python3.12 .deps/python3.12/include/
 fi

@@ -27,7 +27,10 @@
 # names the same runs in every lease (kage.bench.tasks), and DIR must be the same path in every lease, since
 # bench.json records it. COMMIT names the tree's commit (the machine gets no .git) for the
 # packs' provenance, beside the device, the command (each call that started the runner, which trained the
-# task), the call that packed it, and when it was trained and packed. Run with carry [".deps"]:
+# task), the call that packed it, and when it was trained and packed. A call copies the working tree and its carry,
+# which must stay under the device's 64 MiB: the published run data outgrow that, so move every results/ folder but
+# PUBLISHED out of the working tree for the lease's calls (the deletions are not committed) and back afterwards.
+# Run with carry [".deps"]:
 #   COMMIT=$(git rev-parse --short HEAD) GPUS=all PACK=6 bash lab/tools/table_device.sh
 #   COMMIT=... TASK=0 PACK=6 bash lab/tools/table_device.sh
 set -uo pipefail
