@@ -50,6 +50,9 @@ def test_triton_conv_without_triton(monkeypatch, capsys):
     (["--num-minibatches", "3"], "must divide the batch"),
     (["--eval-config-paths", "a", "b", "--eval-config-labels", "x"], "gives 1 labels for 2 eval configs"),
     (["--total-timesteps", "10"], "less than one batch"),
+    (["--eval-num-envs", "0"], "--eval-num-envs 0 must be positive while evaluation is on"),
+    (["--eval-episodes", "0"], "to train without evaluations, pass --run-eval-every 0"),
+    (["--run-eval-every", "-1"], "--run-eval-every -1 must not be negative (0: no evaluation)"),
 ])
 def test_flags_it_cannot_honour(flags, message, capsys):
     with pytest.raises(SystemExit):

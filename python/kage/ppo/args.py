@@ -256,8 +256,11 @@ def validate(args: Args) -> List[str]:
                         f"= {args.batch_size})")
     elif args.num_minibatches > 0 and args.num_iterations < 1:
         problems.append(f"--total-timesteps {args.total_timesteps} is less than one batch ({args.batch_size})")
-    if args.run_eval_every < 0 or args.eval_episodes < 0 or args.eval_num_envs < 0:
-        problems.append("--run-eval-every, --eval-episodes and --eval-num-envs must not be negative")
+    if args.run_eval_every < 0:
+        problems.append(f"--run-eval-every {args.run_eval_every} must not be negative (0: no evaluation)")
+    elif args.run_eval_every > 0 and (args.eval_episodes <= 0 or args.eval_num_envs <= 0):
+        problems.append(f"--eval-episodes {args.eval_episodes} and --eval-num-envs {args.eval_num_envs} must be "
+                        "positive while evaluation is on: to train without evaluations, pass --run-eval-every 0")
     n_evals = len(eval_paths(args))
     if args.eval_config_labels and len(args.eval_config_labels) != n_evals:
         problems.append(f"--eval-config-labels gives {len(args.eval_config_labels)} labels for {n_evals} eval configs")

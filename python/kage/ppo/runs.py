@@ -64,7 +64,7 @@ def open_batches(args: Args, threads: int) -> Run:
     run = Run(args, specs, stages, {path: label for label, path in configs[:len(schedule.distinct_configs(stages))]},
               stream=streams.new_stream(args.device))
     run.env = stage_batch(run, 0, args.num_envs, "--num-envs", threads, seed=args.seed)
-    if args.run_eval_every > 0 and args.eval_episodes > 0 and args.eval_num_envs > 0:
+    if args.run_eval_every > 0:  # the arguments check that its counts are positive then
         run.eval_envs["train"] = stage_batch(run, 0, args.eval_num_envs, "--eval-num-envs", threads)
         for label, path in configs[len(run.labels):]:
             run.eval_envs[label] = make_batch(specs, label, path, args.eval_num_envs, "--eval-num-envs", args, threads,
