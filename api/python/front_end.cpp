@@ -63,7 +63,7 @@ FrontEndResult suite_report(const std::string& manifest) {
   DiagEngine diags(sources);
   DiskFileReader reader;
   const auto suite = load_suite(manifest, sources, reader, diags, runtime_include_dir() + "/configs");
-  if (!suite || diags.has_errors()) return {"", diagnostics_text(diags) + "kage: cannot read suite '" + manifest + "'"};
+  if (!suite || diags.has_errors()) return {"", diagnostics_text(diags) + "kage: suite '" + manifest + "' has errors (above)"};
   const SuiteReport report = run_suite(*suite, ResolveOptions{}, sources, reader, diags, nullptr);
   diags.disable_warnings();
   for (const PairResult& r : report.results)

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 
+#include "compiler/basic/spell.h"
 #include "compiler/parse/compose.h"
 
 namespace kage {
@@ -389,7 +390,22 @@ class SuiteLoader {
     return out;
   }
 
+  /// Reports each key of `map` that is not in `allowed` (the suite schema's properties of `what`), with the
+  /// closest allowed key when one is near.
+  void check_keys(const DocNode& map, const std::vector<std::string>& allowed, const std::string& what) {
+    std::string expected;
+    for (const std::string& k : allowed) expected += (expected.empty() ? "" : ", ") + k;
+    for (const DocEntry& e : map.entries) {
+      if (std::find(allowed.begin(), allowed.end(), e.key) != allowed.end()) continue;
+      const std::optional<std::string> near = suggest(e.key, allowed);
+      diags_.report(Rule::SuiteInvalid, e.key_range,
+                    "unknown key '" + e.key + "' in " + what + (near ? "; did you mean '" + *near + "'?" : "") +
+                        " (expected " + expected + ")");
+    }
+  }
+
   void add_pair(Suite& suite, const DocNode& item) {
+    check_keys(item, {"name", "description", "axis", "train", "eval", "allow"}, "a pair");
     SuitePair p;
     p.name = text_of(item, "name", true);
     p.range = item.range;
@@ -404,6 +420,7 @@ class SuiteLoader {
   }
 
   void add_sweep(Suite& suite, const DocNode& item) {
+    check_keys(item, {"name", "description", "axis", "train", "evals", "allow"}, "a sweep");
     const std::string name = text_of(item, "name", true);
     const auto axis = axis_of(item);
     ConfigRef train_ref;
@@ -416,6 +433,7 @@ class SuiteLoader {
       return;
     }
     for_each_item(*evals, [&](const DocNode& ev) {
+      check_keys(ev, {"name", "config", "allow"}, "a sweep's eval");
       SuitePair p;
       p.sweep = name;
       p.sweep_eval = text_of(ev, "name", true);
