@@ -15,7 +15,7 @@ A stage trains from its start to the iteration before the next one's. At a stage
 environments are made anew for the new mixture and reset (the episodes under way end there, uncounted), with the
 seeds of the stage (`stage_seed`); the network, optimizer and random streams go on."""
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import List, Optional, Sequence, Tuple
 
 import yaml
@@ -31,6 +31,7 @@ class Stage:
     start: int  # its first iteration, from 1
     configs: Tuple[str, ...]  # paths to open
     weights: Optional[Tuple[float, ...]] = None  # None: equal
+    line: Optional[int] = field(default=None, compare=False)  # its start's line in a schedule file
 
     def describe(self) -> dict:
         return {"start": self.start, "configs": list(self.configs),
@@ -89,10 +90,13 @@ def stage_seed(seed: int, stage: int) -> int:
 
 def check_iterations(stages: Sequence[Stage], num_iterations: int, where: str) -> None:
     """Refuses a stage that starts after the run's last iteration: it would never train."""
-    late = [s for s in stages if s.start > num_iterations]
+    late = [(i, s) for i, s in enumerate(stages) if s.start > num_iterations]
     if late:
-        raise ScheduleError(f"{where}: a stage starts at iteration {late[0].start}, but the run has "
-                            f"{num_iterations} iterations: start it earlier, or raise --total-timesteps")
+        i, stage = late[0]
+        at = f"{where}:{stage.line}: stages[{i}].start {stage.start}" if stage.line else \
+            f"{where}: a stage starts at iteration {stage.start}"
+        raise ScheduleError(f"{at}, but the run has {num_iterations} iterations: start it earlier, or raise "
+                            "--total-timesteps")
 
 
 # ---- the schedule file ----
@@ -165,7 +169,7 @@ def _stage(path: str, base: str, i: int, node, stage) -> Stage:
         except ValueError as e:
             raise ScheduleError(f"{path}:{_line(_child(node, 'weights'))}: stages[{i}].{e}") from None
         weights = tuple(float(w) for w in weights)
-    return Stage(start, tuple(resolved), weights)
+    return Stage(start, tuple(resolved), weights, _line(_child(node, "start")))
 
 
 def _line(node) -> int:
