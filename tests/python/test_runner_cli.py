@@ -47,6 +47,14 @@ def test_per_run_flags_are_refused_in_every_spelling(tmp_path, flags, match, com
     assert not (tmp_path / "bench" / "bench.json").exists()
 
 
+def test_a_misspelt_trainer_flag_is_named_in_one_line(tmp_path):
+    suite = write_suite(tmp_path)
+    with pytest.raises(SystemExit) as caught:
+        run.main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *TINY_TRAINING, "--num-env", "2"])
+    assert caught.value.code == "kage.bench: unknown flag --num-env; did you mean --num-envs?"
+    assert not (tmp_path / "bench").exists()
+
+
 def sbatch_lines(script: str):
     return [line for line in script.splitlines() if line.startswith("#SBATCH ")]
 

@@ -60,6 +60,17 @@ def test_flags_it_cannot_honour(flags, message, capsys):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("flags, message", [
+    (["--total-timestep", "5"], "unknown flag --total-timestep; did you mean --total-timesteps?"),
+    (["--num-envs=4", "--xyz=1"], "unknown flag --xyz: python3 -m kage.ppo.train --help lists the flags"),
+    (["--device", "cpu", "7"], "unexpected argument '7': every argument is a --flag or a flag's value"),
+])
+def test_an_unknown_argument_is_named_in_one_line(flags, message):
+    with pytest.raises(SystemExit) as caught:
+        train.parse_args(["--train-config-path", NEAR_GOAL, *flags])
+    assert caught.value.code == f"python3 -m kage.ppo.train: {message}"
+
+
 def test_episodes_shorter_than_a_rollout_are_all_counted(tmp_path):
     # 40-step episodes, 64-step rollouts: an environment can end two episodes in one rollout, so the
     # trainer reads the episode metrics after every step (the benchmark's 500-step episodes are read once).

@@ -334,7 +334,13 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
         if any(arg == flag or arg.startswith(flag + "=") for arg in trainer_args):
             raise SystemExit(f"kage.bench: {flag} is set per run by kage.bench; remove it")
     from kage.ppo import train
-    probe = train.parse_args(["--train-config-path", args.suite, *trainer_args])  # trainer flags checked now
+    try:
+        probe = train.parse_args(["--train-config-path", args.suite, *trainer_args])  # trainer flags checked now
+    except SystemExit as e:
+        prog = "python3 -m kage.ppo.train: "
+        if isinstance(e.code, str) and e.code.startswith(prog):  # a flag the trainer does not have, named here
+            raise SystemExit(f"kage.bench: {e.code[len(prog):]}") from None
+        raise
     if args.pack > 1 and not plugins.is_packable(plugins.load(probe.agent, "--agent")):
         print(f"kage.bench run: --agent {probe.agent} cannot be packed (its factory does not set packable = True): "
               f"its runs train one at a time instead of {args.pack} at once", file=sys.stderr)

@@ -3,6 +3,7 @@ dataclass whose fields are the command line, with the checks of their combinatio
 trains and evaluates on."""
 import argparse
 import dataclasses
+import difflib
 import importlib.util
 import json
 import math
@@ -110,6 +111,17 @@ class Args:
         return self.total_timesteps // self.batch_size
 
 
+def unknown_argument(parser: argparse.ArgumentParser, word: str) -> str:
+    """What is wrong with `word`, the first argument `parser` did not take, and the fix."""
+    if not word.startswith("-"):
+        return f"unexpected argument {word!r}: every argument is a --flag or a flag's value"
+    flag = word.split("=", 1)[0]
+    flags = [o for o in parser._option_string_actions if o.startswith("--") and o != "--help"]
+    near = difflib.get_close_matches(flag, flags, n=1)
+    hint = f"; did you mean {near[0]}?" if near else f": {parser.prog} --help lists the flags"
+    return f"unknown flag {flag}{hint}"
+
+
 # The arguments that differ between the runs of a pack; the others are the pack's, shared.
 PER_RUN = ("train_config_path", "train_config_paths", "train_weights", "train_schedule", "eval_config_path",
            "eval_config_paths", "eval_config_labels", "seed", "out", "exp_name")
@@ -132,7 +144,10 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
             parser.add_argument(flag, type=kind, default=default, help=f.metadata["help"],
                                 choices=f.metadata.get("choices"))
     parser.add_argument("--pack", help="train the runs listed in this JSON file together (written by kage.bench)")
-    namespace = vars(parser.parse_args(argv))
+    known, extras = parser.parse_known_args(argv)
+    if extras:  # one line naming the nearest flag, instead of argparse's usage block
+        raise SystemExit(f"{parser.prog}: {unknown_argument(parser, extras[0])}")
+    namespace = vars(known)
     pack = namespace.pop("pack")
     if pack:
         runs = read_pack(pack, parser)
