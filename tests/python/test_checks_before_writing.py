@@ -94,3 +94,14 @@ def test_a_pack_file_is_checked_as_the_command_line_is(tmp_path):
     with pytest.raises(SystemExit):
         train.main(["--pack", str(pack)])
     assert not (tmp_path / "run1").exists() and not (tmp_path / "run2").exists()
+
+
+def test_a_misspelt_shipped_config_is_named_with_the_nearest_names(tmp_path):
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as refused:
+        train.main(BASE + ["--device", "cpu", "--out", str(out), "--eval-config-path", "kage_bench/background/1-evl"])
+    message = str(refused.value.code)
+    assert message.startswith("kage.ppo.train: (1-evl) config 'kage_bench/background/1-evl' is neither a path nor "
+                              "a shipped config name"), message
+    assert "near names: kage_bench/background/1-eval" in message
+    assert not out.exists()

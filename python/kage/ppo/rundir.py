@@ -277,9 +277,11 @@ def resolve_configs(configs: List[Tuple[str, str]], asset_root: Optional[str]) -
     """Each config's resolved Spec, and the run's description of them ({label: {"path", "spec_sha256"}})."""
     specs = {}
     for label, config in configs:
-        if not os.path.exists(config):
-            raise SystemExit(f"kage.ppo.train: config '{config}' ({label}) not found: give a YAML file, a kagec "
-                             "compile folder or a shipped config's name (kage_bench/bases/shape_black)")
+        if not os.path.exists(config):  # not a path, and (--flags resolved them) not a shipped name
+            try:
+                resources.config_path(config)
+            except FileNotFoundError as e:  # names the shipped configs nearest to it
+                raise SystemExit(f"kage.ppo.train: ({label}) {e}") from None
         try:
             specs[label] = front_end.resolve(config, asset_root)
         except ConfigError as e:
