@@ -3,7 +3,7 @@ of ending the process (and with it every run of its pack)."""
 import json
 import math
 
-from kage.ppo.rundir import RunDir
+from kage.ppo.rundir import Progress, RunDir
 from kage.ppo.tensorboard_log import Board, summary_writer_class
 from kage.util.lock import DirectoryLock
 
@@ -34,3 +34,19 @@ def test_a_null_loss_reaches_tensorboard_as_nan(tmp_path):
     events.Reload()
     assert math.isnan(events.Scalars("losses/approx_kl")[0].value)
     assert events.Scalars("losses/loss")[0].value == 349.5
+
+
+def test_the_eta_counts_the_evaluation_points_to_come(capsys):
+    """Every 3rd of 10 iterations and the last: after iteration 0 four points remain (3, 6, 9, 10), after the
+    last none; without evaluation none. Before any point is timed the line says how many remain."""
+    progress = Progress(10, 1, 3)
+    assert [progress.points_after(i) for i in (0, 3, 8, 9, 10)] == [4, 3, 2, 1, 0]
+    assert Progress(10, 1, 0).points_after(0) == 0
+    assert Progress(9, 1, 3).points_after(8) == 1 and Progress(9, 1, 3).points_after(9) == 0
+    progress.update(1, 1, {"charts/SPS": 1.0}, None)
+    assert "and 4 evaluation points" in capsys.readouterr().err
+    progress.evaluating(3, 2, 4)
+    assert capsys.readouterr().err == "iteration 3: evaluating 4 episodes on each of 2 configs\n"
+    progress.evaluated()
+    progress.update(10, 10, {"charts/SPS": 1.0}, None)
+    assert "evaluation points" not in capsys.readouterr().err

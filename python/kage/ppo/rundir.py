@@ -483,13 +483,32 @@ def check_same_run(path: str, previous: dict, args: dict, configs: dict, stages:
 
 
 class Progress:
-    """One line on stderr every 10 s and at each evaluation: iteration, steps, steps/s and the ETA."""
+    """One line on stderr every 10 s and at each evaluation: iteration, steps, steps/s and the ETA, which counts the
+    evaluation points still to come at the mean time of those so far; and a line as each evaluation point starts."""
 
-    def __init__(self, iterations: int, batch: int):
-        self.iterations, self.batch = iterations, batch
+    def __init__(self, iterations: int, batch: int, eval_every: int):
+        self.iterations, self.batch, self.eval_every = iterations, batch, eval_every
         self.start = time.time()
         self.first_iteration = None
         self.last_print = 0.0
+        self.eval_seconds, self.eval_points, self.eval_start = 0.0, 0, None
+
+    def evaluating(self, iteration: int, configs: int, episodes: int) -> None:
+        """Says that the evaluation point of `iteration` starts (it can take minutes, silently)."""
+        self.eval_start = time.time()
+        print(f"iteration {iteration}: evaluating {episodes} episodes on each of {configs} configs",
+              file=sys.stderr, flush=True)
+
+    def evaluated(self) -> None:
+        self.eval_seconds += time.time() - self.eval_start
+        self.eval_points += 1
+
+    def points_after(self, iteration: int) -> int:
+        """The evaluation points after `iteration`: every eval_every-th iteration, and the last."""
+        if self.eval_every <= 0:
+            return 0
+        every = self.iterations // self.eval_every - iteration // self.eval_every
+        return every + (1 if self.iterations % self.eval_every and iteration < self.iterations else 0)
 
     def update(self, iteration: int, global_step: int, row: dict, evaluation: Optional[dict]) -> None:
         if self.first_iteration is None:
@@ -499,9 +518,14 @@ class Progress:
             return
         self.last_print = now
         done = iteration - self.first_iteration + 1
-        eta = (now - self.start) / done * (self.iterations - iteration)
+        training = (now - self.start - self.eval_seconds) / done * (self.iterations - iteration)
+        points = self.points_after(iteration)
+        if self.eval_points:
+            eta = f"ETA {(training + self.eval_seconds / self.eval_points * points) / 60:.1f} min"
+        else:
+            eta = f"ETA {training / 60:.1f} min" + (f" and {points} evaluation points" if points else "")
         line = (f"iteration {iteration}/{self.iterations}  step {global_step:,}  "
-                f"{row['charts/SPS']:,.0f} steps/s  ETA {eta / 60:.1f} min")
+                f"{row['charts/SPS']:,.0f} steps/s  {eta}")
         if evaluation is not None:
             train = evaluation["train"]
             line += f"  | eval return {fmt(train['return'])} {SUCCESS_SHOWN} {train[SUCCESS_SHOWN]:.2f}"

@@ -145,13 +145,14 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         """The runs' current observations, [K, N, H, W, C]."""
         return stack.stack if stack else torch.stack(frames)
 
-    if resume(runs, agent, optimizer, state, stack, normalizer, boards, device, agent_spec, views, threads):
-        pass
-    elif runs[0].eval_envs:
+    resumed = resume(runs, agent, optimizer, state, stack, normalizer, boards, device, agent_spec, views, threads)
+    progress = rundir.Progress(args.num_iterations, args.batch_size * K,
+                               args.run_eval_every if runs[0].eval_envs else 0)
+    if not resumed and runs[0].eval_envs:
+        progress.evaluating(0, len(runs[0].eval_envs), args.eval_episodes)
         with timer("eval"):  # §3.1: the untrained policy
             evaluation_point(agent, runs, boards, settings, args, 0, 0)
-
-    progress = rundir.Progress(args.num_iterations, args.batch_size * K)
+        progress.evaluated()
     start_iteration = state.iteration + 1
     last_iteration = args.num_iterations if stop_after is None else min(args.num_iterations,
                                                                         start_iteration + stop_after - 1)
@@ -284,9 +285,11 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                           optimizer.param_groups[0]["lr"], ent_coef)
         eval_rows = []
         if runs[0].eval_envs and (iteration % args.run_eval_every == 0 or iteration == last_iteration):
+            progress.evaluating(iteration, len(runs[0].eval_envs), args.eval_episodes)
             with timer("eval"):  # §2.5 step 6, and §3.1's final point
                 eval_rows = evaluation_point(agent, runs, boards, settings, args, iteration, state.global_step,
                                              train_rows=rows)
+            progress.evaluated()
         else:
             for run, board, row in zip(runs, boards, rows):
                 board.write(run.dir.log(row))
