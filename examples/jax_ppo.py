@@ -53,7 +53,11 @@ def parse_args() -> Args:
     for f in dataclasses.fields(Args):
         kind = (lambda s: s.lower() in ("1", "true", "yes")) if f.type is bool else f.type
         parser.add_argument("--" + f.name.replace("_", "-"), type=kind, default=f.default)
-    return Args(**vars(parser.parse_args()))
+    args = Args(**vars(parser.parse_args()))
+    if args.total_timesteps < args.num_envs * args.num_steps:
+        parser.error(f"--total-timesteps {args.total_timesteps} is less than one iteration (--num-envs * --num-steps "
+                     f"= {args.num_envs * args.num_steps}): it would train nothing")
+    return args
 
 
 # ---- the network (spec 1.2, 1.3): Nature CNN torso, actor and critic heads ----
@@ -209,7 +213,10 @@ def make_train(args: Args, env):
 
 def main() -> None:
     args = parse_args()
-    env = kage.jax.make_env(args.config, args.num_envs)
+    try:
+        env = kage.jax.make_env(args.config, args.num_envs)
+    except (FileNotFoundError, ValueError) as e:  # a missing config, a config with errors (located lines)
+        raise SystemExit(f"jax_ppo.py: --config: {e}") from None
     init, iteration = make_train(args, env)
     seeds = args.seed + jnp.arange(args.num_seeds)
     # Op by op, not jitted: in one jitted program XLA's CPU runtime may run several batched QR factorisations

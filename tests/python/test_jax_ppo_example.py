@@ -1,5 +1,5 @@
 """examples/jax_ppo.py: its GAE and optimiser step against hand-computed values, and the whole learner at a tiny
-size on the CPU (two agents vmapped, two iterations, each one jit)."""
+size on the CPU (two agents vmapped, two iterations, each one jit), and its refusals."""
 import importlib.util
 import json
 import math
@@ -65,3 +65,14 @@ def test_two_seeds_train_two_iterations():
     # that collected the data; and the two agents are different agents.
     assert all(kl > 0 for record in lines for kl in record["approx_kl"])
     assert all(record["loss"][0] != record["loss"][1] for record in lines)
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--total-timesteps", "10"], "--total-timesteps 10 is less than one iteration"),
+    (["--config", "nothere.yaml"], "jax_ppo.py: --config: config 'nothere.yaml' is neither a path nor a shipped"),
+])
+def test_a_run_it_cannot_make_is_refused_in_one_line(flags, message):
+    done = subprocess.run([sys.executable, str(ROOT / "examples/jax_ppo.py"), *flags], capture_output=True, text=True,
+                          timeout=300, env=dict(os.environ))
+    assert done.returncode != 0 and message in done.stderr, done.stderr[-2000:]
+    assert "Traceback" not in done.stderr
