@@ -87,7 +87,7 @@ def test_job_array_on_a_local_slurm(tmp_path):
         wait_until(lambda: checkpointed() >= 2, "the run's second checkpoint", 600,
                    lambda: task_logs(out) + slurm.logs())
         status = bench(slurm, "status", str(out))
-        assert "1 runs: 0 done, 1 running" in status.stdout, status.stdout
+        assert "1 run: 0 done, 1 running" in status.stdout, status.stdout
         slurm.command("scancel", job)
         slurm.wait_job(job, lambda s: set(s.values()) <= ENDED, "the cancelled task to end", timeout=120)
         wait_until(lambda: json.loads((run_dir / "bench_state.json").read_text())["state"] == "stopped",

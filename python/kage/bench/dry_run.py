@@ -3,13 +3,15 @@ training or writing anything: for choosing --pack and --tasks so that a lease's 
 from typing import List, Optional
 
 from kage.bench import gpus, tasks
+from kage.util.text import plural
 
 
 def describe(bench, devices: Optional[List[int]], only: Optional[List[int]]) -> str:
     """The task table of `bench`, then, for the GPUs `devices` (the indices --gpus names), the tasks each would
     train (longest first) and its share of the busiest GPU's work."""
     table = bench.table()
-    lines = [f"kage.bench run --dry-run: {len(table)} tasks, {sum(map(len, table))} runs (--pack {bench.pack}"
+    lines = [f"kage.bench run --dry-run: {plural(len(table), 'task')}, {plural(sum(map(len, table)), 'run')} "
+             f"(--pack {bench.pack}"
              f"{', --share-training' if bench.share_training else ''}); nothing trained or written"]
     for i, task in enumerate(table):
         units = sorted({unit.name for unit, _, _ in task})
@@ -27,10 +29,6 @@ def describe(bench, devices: Optional[List[int]], only: Optional[List[int]]) -> 
             lines.append(f"  GPU {g}: {names if worker else 'no task'}, weight {load} "
                          f"({100 * load / busiest:.0f} % of the busiest)")
     return "\n".join(lines)
-
-
-def plural(count: int, noun: str) -> str:
-    return f"{count} {noun}{'' if count == 1 else 's'}"
 
 
 def devices_of(text: str) -> List[int]:

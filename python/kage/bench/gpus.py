@@ -17,6 +17,7 @@ from typing import List, Optional, Tuple
 
 from kage.bench import tasks
 from kage.util.stop import child_environment, stop_children
+from kage.util.text import plural
 
 FAKE_GPUS = "KAGE_BENCH_FAKE_GPUS"
 
@@ -116,7 +117,7 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: O
     todo = longest_first(table, unfinished)
     finished = sum(all(map(tasks.is_finished, task)) for task in table)
     scope = "" if only is None else f" (of tasks {','.join(map(str, only))})"
-    print(f"kage.bench run: {len(table)} tasks, {finished} finished earlier; {len(todo)} to train{scope} on "
+    print(f"kage.bench run: {plural(len(table), 'task')}, {finished} finished earlier; {len(todo)} to train{scope} on "
           f"GPUs {','.join(devices)}", file=sys.stderr, flush=True)
     log_dir = os.path.join(bench.out, "tasks")
     os.makedirs(log_dir, exist_ok=True)

@@ -21,6 +21,7 @@ from typing import List
 
 from kage.bench import run, tasks
 from kage.util.files import atomic_write, os_error_text
+from kage.util.text import plural
 
 PATH_FLAGS = ("--asset-root",)  # trainer flags that name a path: made absolute for the tasks
 
@@ -79,7 +80,8 @@ def script(bench: run.Bench, table: List[List[tasks.Job]], args: argparse.Namesp
         directives.append(f"--gpus-per-task={gpus}")
     command = " ".join(map(shlex.quote, bench.run_command()))
     lines = ["#!/bin/bash",
-             f"# kage.bench: {len(table)} tasks, {sum(map(len, table))} runs of {bench.suite} into {bench.out}",
+             f"# kage.bench: {plural(len(table), 'task')}, {plural(sum(map(len, table)), 'run')} of {bench.suite} "
+             f"into {bench.out}",
              "# (written by python3 -m kage.bench slurm; progress: python3 -m kage.bench status DIR)",
              *(f"#SBATCH {d}" for d in directives),
              "set -euo pipefail",

@@ -10,6 +10,7 @@ from kage.bench.records import bench_problem
 from kage.bench.run import checkpoint_iteration
 from kage.bench.tasks import run_dir
 from kage.util.files import read_json_record
+from kage.util.text import plural
 
 ORDER = ("done", "running", "failed", "interrupted", "not started")
 
@@ -60,7 +61,7 @@ def status(bench_dir: str, out: TextIO) -> Dict[str, List[str]]:
             category, detail = classify(run_dir(bench_dir, unit, seed), now)
             found[category].append((f"{unit} seed {seed}", detail))
     total = sum(map(len, found.values()))
-    out.write(f"{bench_dir}: {total} runs: " + ", ".join(f"{len(found[c])} {c}" for c in ORDER) + "\n")
+    out.write(f"{bench_dir}: {plural(total, 'run')}: " + ", ".join(f"{len(found[c])} {c}" for c in ORDER) + "\n")
     for category in ORDER[1:-1]:
         if found[category]:
             out.write(f"{category}:\n" + "".join(f"  {name}: {detail}\n" for name, detail in found[category]))

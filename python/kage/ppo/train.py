@@ -65,6 +65,7 @@ from kage.ppo.runs import BatchViews, Run, compile_kernels, enter_stage, open_ba
 from kage.ppo.wrappers import FrameStack, RewardNormalizer
 from kage.util.files import os_error_text, safe
 from kage.util.stop import StopRequest, die_with_parent
+from kage.util.text import plural
 
 ACTION_STREAM, SHUFFLE_STREAM = 1, 2  # the two random streams of a run (§2.4); evaluations use their own keys
 AUGMENT_STREAM = 3  # --augment's draws on update minibatches (update and drac modes; not in the original)
@@ -99,7 +100,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     runs = [open_batches(a, threads) for a in pack]
     K, T, N = len(runs), args.num_steps, args.num_envs
     # A pack's start takes a while (its configs' kernels, then a batch per run and config): the log says how long.
-    print(f"kage.ppo.train: {sum(1 + len(run.eval_envs) for run in runs)} batches of {K} runs opened in "
+    print(f"kage.ppo.train: {plural(sum(1 + len(run.eval_envs) for run in runs), 'batch', 'batches')} of "
+          f"{plural(K, 'run')} opened in "
           f"{time.perf_counter() - opening:.1f} s", file=sys.stderr)
     height, width, channels = runs[0].env.single_observation_space.shape
     channels *= 4 if args.use_frame_stack else 1
