@@ -91,6 +91,14 @@ def test_report_and_status_refuse_a_bench_json_that_run_would_not_write(tmp_path
     refusal(lambda: status.status(str(tmp_path), io.StringIO()), path, said, "restore it")
 
 
+def test_status_of_a_folder_that_is_no_benchmark_says_so(tmp_path):
+    missing = tmp_path / "nowhere"
+    with pytest.raises(SystemExit) as refused:
+        status.status(str(missing), io.StringIO())
+    assert refused.value.code == (f"{missing / 'bench.json'}: error: no such file: {missing} is not a directory "
+                                  "written by python3 -m kage.bench run (or slurm): give the --out of a benchmark")
+
+
 def test_a_malformed_shared_entry_is_refused(tmp_path):
     bench_dir(tmp_path, [eval_row(0, 0.5, {"eval": 0.5})])
     bench = json.loads((tmp_path / "bench.json").read_text())

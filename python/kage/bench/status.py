@@ -49,6 +49,9 @@ def status(bench_dir: str, out: TextIO) -> Dict[str, List[str]]:
     path = os.path.join(bench_dir, "bench.json")
     try:
         bench, problem = read_json_record(path, lambda value: bench_problem(value, ("units", "seeds")))
+    except FileNotFoundError:
+        raise SystemExit(f"{path}: error: no such file: {bench_dir} is not a directory written by python3 -m "
+                         "kage.bench run (or slurm): give the --out of a benchmark") from None
     except OSError as e:
         problem = e.strerror or str(e)
     if problem:
