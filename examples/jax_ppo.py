@@ -215,7 +215,7 @@ def main() -> None:
     args = parse_args()
     try:
         env = kage.jax.make_env(args.config, args.num_envs)
-    except (FileNotFoundError, ValueError) as e:  # a missing config, a config with errors (located lines)
+    except (FileNotFoundError, kage.ConfigError) as e:  # a missing config, a config with errors (located lines)
         raise SystemExit(f"jax_ppo.py: --config: {e}") from None
     init, iteration = make_train(args, env)
     seeds = args.seed + jnp.arange(args.num_seeds)

@@ -29,7 +29,6 @@ namespace kage::jax {
 namespace ffi = xla::ffi;
 namespace {
 
-constexpr unsigned kPerEnvThreads = 256;
 
 /// A config's kernels and assets on device 0. Kept for the life of the process: a compiled XLA program may
 /// run until it ends.
@@ -61,12 +60,6 @@ std::optional<CudaModule> load_module(const JaxConfig& c, std::string* error) {
   return CudaModule::compile(source, generated_file_name(c.spec_hash), generated_source_options(), error);
 }
 
-bool check(CUresult r, const char* what, std::string* error) {
-  if (r == CUDA_SUCCESS) return true;
-  *error = cu_error_text(r, what);
-  return false;
-}
-
 std::unique_ptr<DeviceProgram> load_program(const JaxConfig& c, std::string* error) {
   if (!render_supported(c.visual)) {
     *error = "frame size " + std::to_string(c.visual.H) + "x" + std::to_string(c.visual.W) + " not supported on the GPU";
@@ -88,10 +81,10 @@ std::unique_ptr<DeviceProgram> load_program(const JaxConfig& c, std::string* err
   p->render_threads = render_threads(c.visual);
   p->render_smem = render_dynamic_smem_bytes(c.visual);
   CUdevice dev;
-  if (!check(cuCtxGetDevice(&dev), "cuCtxGetDevice", error) ||
-      !check(cuDeviceGetAttribute(&p->multiprocessors, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, dev),
+  if (!cu_check(cuCtxGetDevice(&dev), "cuCtxGetDevice", error) ||
+      !cu_check(cuDeviceGetAttribute(&p->multiprocessors, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, dev),
              "cuDeviceGetAttribute(multiprocessors)", error) ||
-      !check(cuFuncSetAttribute(p->render, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, p->render_smem),
+      !cu_check(cuFuncSetAttribute(p->render, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, p->render_smem),
              "cuFuncSetAttribute(dynamic shared memory)", error))
     return nullptr;
   return p;
@@ -164,10 +157,10 @@ ffi::Error launch(const char* call, const JaxConfig& c, const DeviceProgram& p, 
   const int32_t frames = frames_per_block(c.visual, e.num_envs, p.multiprocessors);
   const unsigned render_grid = static_cast<unsigned>((e.num_envs + frames - 1) / frames);
   // The driver acts on the calling thread's context: device 0's primary context, which XLA's is.
-  if (check(cuCtxSetCurrent(p.context), "cuCtxSetCurrent", &error) &&
-      check(cuLaunchKernel(per_env, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream, args, nullptr), "cuLaunchKernel",
+  if (cu_check(cuCtxSetCurrent(p.context), "cuCtxSetCurrent", &error) &&
+      cu_check(cuLaunchKernel(per_env, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream, args, nullptr), "cuLaunchKernel",
             &error) &&
-      check(cuLaunchKernel(p.render, render_grid, 1, 1, static_cast<unsigned>(p.render_threads), 1, 1,
+      cu_check(cuLaunchKernel(p.render, render_grid, 1, 1, static_cast<unsigned>(p.render_threads), 1, 1,
                            static_cast<unsigned>(p.render_smem), stream, args, nullptr),
             "cuLaunchKernel(kage_render)", &error))
     return ffi::Error::Success();
@@ -193,10 +186,10 @@ ffi::Error reset(CUstream stream, int32_t ordinal, CudaInstance* instance, std::
   std::string error;
   // Fresh buffers: zero the state first, so that padding and unused entity slots are defined bytes.
   const auto zero = [&](void* at, size_t bytes) {
-    return check(cuMemsetD8Async(reinterpret_cast<CUdeviceptr>(at), 0, bytes, stream), "cuMemsetD8Async", &error);
+    return cu_check(cuMemsetD8Async(reinterpret_cast<CUdeviceptr>(at), 0, bytes, stream), "cuMemsetD8Async", &error);
   };
   const size_t n = static_cast<size_t>(b.n);
-  if (!check(cuCtxSetCurrent(p.context), "cuCtxSetCurrent", &error) || !zero(b.latent, n * sizeof(LatentState)) ||
+  if (!cu_check(cuCtxSetCurrent(p.context), "cuCtxSetCurrent", &error) || !zero(b.latent, n * sizeof(LatentState)) ||
       !zero(b.segments, n * static_cast<size_t>(c.segment_stride)) || !zero(b.visual, n * sizeof(VisualState)))
     return handler_error("kage_reset", error);
   return launch("kage_reset", c, p, p.reset, device_envs(c, p, b), stream);
@@ -211,10 +204,10 @@ ffi::Error step(CUstream stream, int32_t ordinal, CudaInstance* instance, std::s
   if (got->n > INT32_MAX) return handler_error("kage_step", "more than 2^31 - 1 environments");
   const DeviceProgram& p = *instance->program;
   std::string error;
-  if (!check(cuCtxSetCurrent(p.context), "cuCtxSetCurrent", &error)) return handler_error("kage_step", error);
+  if (!cu_check(cuCtxSetCurrent(p.context), "cuCtxSetCurrent", &error)) return handler_error("kage_step", error);
   for (size_t i = 0; i < got->copy_count; ++i) {
     const InPlaceCopy& copy = got->copies[i];
-    if (!check(cuMemcpyDtoDAsync(reinterpret_cast<CUdeviceptr>(copy.to), reinterpret_cast<CUdeviceptr>(copy.from),
+    if (!cu_check(cuMemcpyDtoDAsync(reinterpret_cast<CUdeviceptr>(copy.to), reinterpret_cast<CUdeviceptr>(copy.from),
                                  copy.bytes, stream),
                "cuMemcpyDtoDAsync", &error))
       return handler_error("kage_step", error);

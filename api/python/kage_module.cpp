@@ -38,6 +38,9 @@ ErrorClasses& error_classes() {
 
 void raise_value_error(const std::string& message) { throw py::value_error(message); }
 
+/// What a call on a closed batch raises.
+constexpr const char* kClosed = "this environment is closed: make a new one with kage.make_vec";
+
 /// Text from the runtime or the front end as a Python str. A config need not be UTF-8, and its lines are
 /// quoted in diagnostics: undecodable bytes become U+FFFD instead of a UnicodeDecodeError that would hide
 /// the located message.
@@ -198,7 +201,7 @@ class PyEnv {
         for (std::mutex* m : mutexes) held.emplace_back(*m);
         std::vector<kage::Env*> batches;
         for (PyEnv* env : envs) {
-          if (!env->env_) throw std::runtime_error("this environment is closed: make a new one with kage.make_vec");
+          if (!env->env_) throw std::runtime_error(kClosed);
           batches.push_back(env->env_.get());
         }
         int64_t failed = -1;
@@ -323,7 +326,7 @@ class PyEnv {
   std::invoke_result_t<F, kage::Env&> locked(F&& f) const {
     py::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(*mutex_);
-    if (!env_) throw std::runtime_error("this environment is closed: make a new one with kage.make_vec");
+    if (!env_) throw std::runtime_error(kClosed);
     return f(*env_);
   }
 

@@ -17,16 +17,8 @@
 namespace kage {
 namespace {
 
-constexpr int32_t kPerEnvThreads = 256;
-
 /// Rounds up to a multiple of 256 bytes (the alignment of every sub-buffer).
 size_t align256(size_t n) { return (n + 255) / 256 * 256; }
-
-bool check(CUresult r, const char* what, std::string* error) {
-  if (r == CUDA_SUCCESS) return true;
-  *error = cu_error_text(r, what);
-  return false;
-}
 
 /// Sub-buffer offsets of the per-env state allocation.
 struct StateLayout {
@@ -114,7 +106,7 @@ bool upload_dynamic_params(const CudaModule& module, const LatentParams& lp, con
         *error = std::string("DeviceBatch: ") + u.name + " has another size in the module: rebuild it";
         return false;
       }
-      if (!check(cuMemcpyHtoD(p, u.src, u.bytes), "cuMemcpyHtoD(params)", error)) return false;
+      if (!cu_check(cuMemcpyHtoD(p, u.src, u.bytes), "cuMemcpyHtoD(params)", error)) return false;
     }
   }
   return true;
@@ -136,9 +128,9 @@ std::optional<DeviceAssets> upload_assets(const AssetView& ha, std::string* erro
     total += align256(tables[i]->count * sizeof(SpriteSet));
   }
   DeviceAssets d;
-  if (!check(cuMemAlloc(&d.memory, std::max<size_t>(total, 256)), "cuMemAlloc(assets)", error)) return std::nullopt;
+  if (!cu_check(cuMemAlloc(&d.memory, std::max<size_t>(total, 256)), "cuMemAlloc(assets)", error)) return std::nullopt;
   auto upload = [&](size_t off, const void* src, size_t bytes) {
-    return bytes == 0 || check(cuMemcpyHtoD(d.memory + off, src, bytes), "cuMemcpyHtoD(assets)", error);
+    return bytes == 0 || cu_check(cuMemcpyHtoD(d.memory + off, src, bytes), "cuMemcpyHtoD(assets)", error);
   };
   bool ok = upload(0, ha.bg, bg_bytes) && upload(o_px, ha.sprite_pixels, px_bytes) &&
             upload(o_frames, ha.frames, frames * sizeof(SpriteFrame));
@@ -250,8 +242,8 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
   }
   CUdevice dev;
   int multiprocessors = 0;
-  if (!check(cuCtxGetDevice(&dev), "cuCtxGetDevice", error) ||
-      !check(cuDeviceGetAttribute(&multiprocessors, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, dev),
+  if (!cu_check(cuCtxGetDevice(&dev), "cuCtxGetDevice", error) ||
+      !cu_check(cuDeviceGetAttribute(&multiprocessors, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, dev),
              "cuDeviceGetAttribute(multiprocessors)", error))
     return std::nullopt;
 
@@ -281,7 +273,7 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
     p.render_smem = render_dynamic_smem_bytes(src.vp);
     p.frames_per_block = frames_per_block(src.vp, std::max(src.num_envs, 1), multiprocessors);
     for (CUfunction render : {p.render, p.render_rows})
-      if (!check(cuFuncSetAttribute(render, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, p.render_smem),
+      if (!cu_check(cuFuncSetAttribute(render, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, p.render_smem),
                  "cuFuncSetAttribute(dynamic shared memory)", error))
         return std::nullopt;
     std::optional<DeviceAssets> assets = upload_assets(src.host_assets, error);
@@ -302,21 +294,21 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
   const int32_t stride = segment_stride_bytes(b.segment_count_);
   const StateLayout l = state_layout(n, static_cast<size_t>(stride));
   b.obs_stride_ = static_cast<size_t>(p0.vp.H) * p0.vp.W * 3;
-  if (!check(cuMemAlloc(&b.state_, l.total), "cuMemAlloc(state)", error)) return std::nullopt;
-  if (!check(cuMemsetD8(b.state_, 0, l.total), "cuMemsetD8(state)", error)) return std::nullopt;
-  if (!check(cuMemAlloc(&b.obs_buf_, 2 * n * b.obs_stride_), "cuMemAlloc(observations)", error)) return std::nullopt;
+  if (!cu_check(cuMemAlloc(&b.state_, l.total), "cuMemAlloc(state)", error)) return std::nullopt;
+  if (!cu_check(cuMemsetD8(b.state_, 0, l.total), "cuMemsetD8(state)", error)) return std::nullopt;
+  if (!cu_check(cuMemAlloc(&b.obs_buf_, 2 * n * b.obs_stride_), "cuMemAlloc(observations)", error)) return std::nullopt;
   const size_t count_bytes = parts.size() * sizeof(StepCount);
-  if (!check(cuMemAlloc(&b.step_counts_, count_bytes), "cuMemAlloc(step counts)", error) ||
-      !check(cuMemsetD8(b.step_counts_, 0, count_bytes), "cuMemsetD8(step counts)", error))
+  if (!cu_check(cuMemAlloc(&b.step_counts_, count_bytes), "cuMemAlloc(step counts)", error) ||
+      !cu_check(cuMemsetD8(b.step_counts_, 0, count_bytes), "cuMemsetD8(step counts)", error))
     return std::nullopt;
   // One host-mapped report slot per part: a part's kernels number its environments from 0.
   void* mapped = nullptr;
   CUdeviceptr mapped_device = 0;
   const size_t report_bytes = parts.size() * sizeof(ActionError);
-  if (!check(cuMemHostAlloc(&mapped, report_bytes, CU_MEMHOSTALLOC_DEVICEMAP), "cuMemHostAlloc", error)) return std::nullopt;
+  if (!cu_check(cuMemHostAlloc(&mapped, report_bytes, CU_MEMHOSTALLOC_DEVICEMAP), "cuMemHostAlloc", error)) return std::nullopt;
   b.action_error_ = static_cast<ActionError*>(mapped);
   for (size_t k = 0; k < parts.size(); ++k) b.action_error_[k] = ActionError{};
-  if (!check(cuMemHostGetDevicePointer(&mapped_device, mapped, 0), "cuMemHostGetDevicePointer", error))
+  if (!cu_check(cuMemHostGetDevicePointer(&mapped_device, mapped, 0), "cuMemHostGetDevicePointer", error))
     return std::nullopt;
   auto ptr = [&](size_t off) { return reinterpret_cast<uint8_t*>(b.state_ + off); };
   DeviceEnvs& e = b.envs_;
@@ -359,10 +351,10 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
 }
 
 bool DeviceBatch::create_part_streams(std::string* error) {
-  if (!check(cuEventCreate(&fork_, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error)) return false;
+  if (!cu_check(cuEventCreate(&fork_, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error)) return false;
   for (Part& p : parts_)
-    if (!check(cuStreamCreate(&p.stream, CU_STREAM_NON_BLOCKING), "cuStreamCreate", error) ||
-        !check(cuEventCreate(&p.stepped, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error))
+    if (!cu_check(cuStreamCreate(&p.stream, CU_STREAM_NON_BLOCKING), "cuStreamCreate", error) ||
+        !cu_check(cuEventCreate(&p.stepped, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error))
       return false;
   return true;
 }
@@ -409,7 +401,7 @@ bool DeviceBatch::launch_per_env(CUfunction f, const DeviceEnvs& envs, CUstream 
   DeviceEnvs arg = envs;
   void* args[] = {&arg};
   const unsigned grid = static_cast<unsigned>((envs.num_envs + kPerEnvThreads - 1) / kPerEnvThreads);
-  return check(cuLaunchKernel(f, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream, args, nullptr), "cuLaunchKernel", error);
+  return cu_check(cuLaunchKernel(f, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream, args, nullptr), "cuLaunchKernel", error);
 }
 
 bool DeviceBatch::launch_render(const Part& p, CUstream stream, std::string* error) {
@@ -417,7 +409,7 @@ bool DeviceBatch::launch_render(const Part& p, CUstream stream, std::string* err
   DeviceEnvs arg = p.envs;
   void* args[] = {&arg};
   const unsigned grid = static_cast<unsigned>((p.envs.num_envs + p.frames_per_block - 1) / p.frames_per_block);
-  return check(cuLaunchKernel(p.render, grid, 1, 1, static_cast<unsigned>(p.render_threads),
+  return cu_check(cuLaunchKernel(p.render, grid, 1, 1, static_cast<unsigned>(p.render_threads),
                               1, 1, static_cast<unsigned>(p.render_smem), stream, args, nullptr),
                "cuLaunchKernel", error);
 }
@@ -434,9 +426,9 @@ bool DeviceBatch::reset(const uint64_t* seeds, const uint8_t* mask, std::string*
   for (size_t i = 0; i < n; ++i)
     if (!mask || mask[i]) seeds_[i] = seeds[i];
   const CUdeviceptr d = reinterpret_cast<CUdeviceptr>(envs_.seeds);
-  if (!check(cuMemcpyHtoDAsync(d, seeds_.data(), sizeof(uint64_t) * n, stream_), "cuMemcpyHtoDAsync(seeds)", error))
+  if (!cu_check(cuMemcpyHtoDAsync(d, seeds_.data(), sizeof(uint64_t) * n, stream_), "cuMemcpyHtoDAsync(seeds)", error))
     return false;
-  if (mask && !check(cuMemcpyHtoDAsync(reinterpret_cast<CUdeviceptr>(reset_mask_), mask, n, stream_),
+  if (mask && !cu_check(cuMemcpyHtoDAsync(reinterpret_cast<CUdeviceptr>(reset_mask_), mask, n, stream_),
                      "cuMemcpyHtoDAsync(reset mask)", error))
     return false;
   for (const Part& p : parts_) {
@@ -452,7 +444,7 @@ bool DeviceBatch::launch_step(const ActionSource& source, bool render, std::stri
   // One part steps on stream_; a mixture's parts each on their own stream, forked from stream_ and joined
   // back, since a part's few environments leave the GPU mostly idle while its kernels run.
   const bool fork = parts_.size() > 1;
-  if (fork && !check(cuEventRecord(fork_, stream_), "cuEventRecord", error)) return false;
+  if (fork && !cu_check(cuEventRecord(fork_, stream_), "cuEventRecord", error)) return false;
   for (const Part& p : parts_) {
     DeviceEnvs v = p.envs;
     v.actions = source;
@@ -460,18 +452,18 @@ bool DeviceBatch::launch_step(const ActionSource& source, bool render, std::stri
     v.actions.count = p.envs.actions.count;
     v.actions.error = p.envs.actions.error;
     const CUstream stream = fork ? p.stream : stream_;
-    if ((fork && !check(cuStreamWaitEvent(stream, fork_, 0), "cuStreamWaitEvent", error)) ||
+    if ((fork && !cu_check(cuStreamWaitEvent(stream, fork_, 0), "cuStreamWaitEvent", error)) ||
         !launch_per_env(p.step, v, stream, error) || (render && !launch_render(p, stream, error)))
       return false;
-    if (fork && !(check(cuEventRecord(p.stepped, stream), "cuEventRecord", error) &&
-                  check(cuStreamWaitEvent(stream_, p.stepped, 0), "cuStreamWaitEvent", error)))
+    if (fork && !(cu_check(cuEventRecord(p.stepped, stream), "cuEventRecord", error) &&
+                  cu_check(cuStreamWaitEvent(stream_, p.stepped, 0), "cuStreamWaitEvent", error)))
       return false;
   }
   return true;
 }
 
 bool DeviceBatch::step(const int32_t* actions, std::string* error) {
-  return check(cuMemcpyHtoDAsync(this->actions(), actions, sizeof(int32_t) * envs_.num_envs, stream_),
+  return cu_check(cuMemcpyHtoDAsync(this->actions(), actions, sizeof(int32_t) * envs_.num_envs, stream_),
                "cuMemcpyHtoDAsync(actions)", error) &&
          step_device_actions(error);
 }
@@ -501,11 +493,11 @@ std::optional<ActionError> DeviceBatch::take_action_error() {
 }
 
 bool DeviceBatch::synchronize(std::string* error) const {
-  return check(cuStreamSynchronize(stream_), "cuStreamSynchronize", error);
+  return cu_check(cuStreamSynchronize(stream_), "cuStreamSynchronize", error);
 }
 
 bool DeviceBatch::download_obs(uint8_t* host, std::string* error) const {
-  return check(cuMemcpyDtoHAsync(host, obs(), obs_stride_ * static_cast<size_t>(envs_.num_envs), stream_),
+  return cu_check(cuMemcpyDtoHAsync(host, obs(), obs_stride_ * static_cast<size_t>(envs_.num_envs), stream_),
                "cuMemcpyDtoHAsync(obs)", error) &&
          synchronize(error);
 }
@@ -515,7 +507,7 @@ bool DeviceBatch::sample_actions(uint64_t seed, uint32_t t, std::string* error) 
   int32_t n = envs_.num_envs;
   void* args[] = {&actions, &n, &seed, &t};
   const unsigned grid = static_cast<unsigned>((n + kPerEnvThreads - 1) / kPerEnvThreads);
-  return check(cuLaunchKernel(sample_actions_, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream_, args, nullptr),
+  return cu_check(cuLaunchKernel(sample_actions_, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream_, args, nullptr),
                "cuLaunchKernel(kage_sample_actions)", error);
 }
 
@@ -573,7 +565,7 @@ bool DeviceBatch::copy_state(uint8_t* blob, bool to_host, std::string* error) co
     }
     c.WidthInBytes = s.bytes_per_env;
     c.Height = n;
-    if (!check(cuMemcpy2DAsync(&c, stream_), "cuMemcpy2DAsync(state)", error)) return false;
+    if (!cu_check(cuMemcpy2DAsync(&c, stream_), "cuMemcpy2DAsync(state)", error)) return false;
   }
   return true;
 }
@@ -597,7 +589,7 @@ bool DeviceBatch::load_state(const uint8_t* data, size_t size, const std::string
   std::memcpy(seeds_.data(), data + l.seeds, n * sizeof(uint64_t));
   // Frames are a pure function of the state: render them again instead of saving them. The copies
   // read pageable host memory, so they are complete when this returns.
-  return check(cuMemsetD8Async(reinterpret_cast<CUdeviceptr>(envs_.final_mask), 0, n, stream_),
+  return cu_check(cuMemsetD8Async(reinterpret_cast<CUdeviceptr>(envs_.final_mask), 0, n, stream_),
                "cuMemsetD8Async(final mask)", error) &&
          launch_renders(error) && synchronize(error);
 }

@@ -68,6 +68,9 @@ struct DevicePartSource {
 
 struct GroupPlan;
 
+/// Threads per block of the kernels with one thread per environment (reset, step, random actions).
+constexpr int32_t kPerEnvThreads = 256;
+
 class DeviceBatch {
  public:
   /// A batch of `num_envs` environments running `module`'s kernels with these parameters (uploaded to

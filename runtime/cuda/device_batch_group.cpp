@@ -10,14 +10,6 @@
 namespace kage {
 namespace {
 
-constexpr int32_t kStepThreads = 256;
-
-bool check(CUresult r, const char* what, std::string* error) {
-  if (r == CUDA_SUCCESS) return true;
-  *error = cu_error_text(r, what);
-  return false;
-}
-
 /// Lets this thread make a plan (allocate, copy, create streams) while a stream capture is under way on it
 /// (a CUDA graph's first call): the plan's work is ordered on a stream of its own, outside the capture.
 class RelaxedCapture {
@@ -34,9 +26,9 @@ class RelaxedCapture {
 /// Copies `bytes` from host memory to `device` on a stream of its own and waits for it.
 bool upload(CUdeviceptr device, const void* host, size_t bytes, std::string* error) {
   CUstream stream = nullptr;
-  if (!check(cuStreamCreate(&stream, CU_STREAM_NON_BLOCKING), "cuStreamCreate", error)) return false;
-  const bool ok = check(cuMemcpyHtoDAsync(device, host, bytes, stream), "cuMemcpyHtoDAsync(group rows)", error) &&
-                  check(cuStreamSynchronize(stream), "cuStreamSynchronize", error);
+  if (!cu_check(cuStreamCreate(&stream, CU_STREAM_NON_BLOCKING), "cuStreamCreate", error)) return false;
+  const bool ok = cu_check(cuMemcpyHtoDAsync(device, host, bytes, stream), "cuMemcpyHtoDAsync(group rows)", error) &&
+                  cu_check(cuStreamSynchronize(stream), "cuStreamSynchronize", error);
   cuStreamDestroy(stream);
   return ok;
 }
@@ -97,19 +89,19 @@ GroupPlan* DeviceBatch::group_plan(const std::vector<DeviceBatch*>& batches, std
     plan->launches.push_back(l);
   }
   const size_t bytes = std::max<size_t>(rows.size(), 1) * sizeof(GroupRow);
-  if (!check(cuMemAlloc(&plan->rows, bytes), "cuMemAlloc(group rows)", error) ||
+  if (!cu_check(cuMemAlloc(&plan->rows, bytes), "cuMemAlloc(group rows)", error) ||
       (!rows.empty() && !upload(plan->rows, rows.data(), rows.size() * sizeof(GroupRow), error)))
     return nullptr;
   if (plan->launches.size() > 1)
     for (GroupLaunch& l : plan->launches)
-      if (!check(cuStreamCreate(&l.stream, CU_STREAM_NON_BLOCKING), "cuStreamCreate", error) ||
-          !check(cuEventCreate(&l.done, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error))
+      if (!cu_check(cuStreamCreate(&l.stream, CU_STREAM_NON_BLOCKING), "cuStreamCreate", error) ||
+          !cu_check(cuEventCreate(&l.done, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error))
         return nullptr;
   plan->queued.assign(batches.size(), nullptr);
   for (CUevent* e : {&plan->entered, &plan->fork, &plan->stepped})
-    if (!check(cuEventCreate(e, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error)) return nullptr;
+    if (!cu_check(cuEventCreate(e, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error)) return nullptr;
   for (CUevent& e : plan->queued)
-    if (!check(cuEventCreate(&e, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error)) return nullptr;
+    if (!cu_check(cuEventCreate(&e, CU_EVENT_DISABLE_TIMING), "cuEventCreate", error)) return nullptr;
   plans_.push_back(std::move(plan));
   return plans_.back().get();
 }
@@ -127,15 +119,15 @@ bool DeviceBatch::step_together(const std::vector<DeviceBatch*>& batches, const 
   // After the work queued so far on every batch's stream (a consumer of its last outputs, its reset). The
   // other streams first wait for the lead's (the actions' producer ordered itself before it): under a stream
   // capture that brings them into the capture, whose streams may only wait for captured work.
-  if (!check(cuEventRecord(plan->entered, main), "cuEventRecord", error)) return false;
+  if (!cu_check(cuEventRecord(plan->entered, main), "cuEventRecord", error)) return false;
   for (size_t i = 1; i < batches.size(); ++i)
     if (batches[i]->stream_ != main &&
-        !(check(cuStreamWaitEvent(batches[i]->stream_, plan->entered, 0), "cuStreamWaitEvent", error) &&
-          check(cuEventRecord(plan->queued[i], batches[i]->stream_), "cuEventRecord", error) &&
-          check(cuStreamWaitEvent(main, plan->queued[i], 0), "cuStreamWaitEvent", error)))
+        !(cu_check(cuStreamWaitEvent(batches[i]->stream_, plan->entered, 0), "cuStreamWaitEvent", error) &&
+          cu_check(cuEventRecord(plan->queued[i], batches[i]->stream_), "cuEventRecord", error) &&
+          cu_check(cuStreamWaitEvent(main, plan->queued[i], 0), "cuStreamWaitEvent", error)))
       return false;
   const bool fork = plan->launches.size() > 1;
-  if (fork && !check(cuEventRecord(plan->fork, main), "cuEventRecord", error)) return false;
+  if (fork && !cu_check(cuEventRecord(plan->fork, main), "cuEventRecord", error)) return false;
   for (const GroupLaunch& l : plan->launches) {
     const CUstream stream = fork ? l.stream : main;
     CUdeviceptr rows = plan->rows + static_cast<CUdeviceptr>(l.first_row) * sizeof(GroupRow);
@@ -143,23 +135,23 @@ bool DeviceBatch::step_together(const std::vector<DeviceBatch*>& batches, const 
     void* step_args[] = {&rows, &source};
     void* render_args[] = {&rows};
     const auto rows_y = static_cast<unsigned>(l.row_count);
-    const auto step_x = static_cast<unsigned>((l.max_envs + kStepThreads - 1) / kStepThreads);
+    const auto step_x = static_cast<unsigned>((l.max_envs + kPerEnvThreads - 1) / kPerEnvThreads);
     const auto render_x = static_cast<unsigned>((l.max_envs + l.frames_per_block - 1) / l.frames_per_block);
-    if ((fork && !check(cuStreamWaitEvent(stream, plan->fork, 0), "cuStreamWaitEvent", error)) ||
-        !check(cuLaunchKernel(l.step_rows, step_x, rows_y, 1, kStepThreads, 1, 1, 0, stream, step_args, nullptr),
+    if ((fork && !cu_check(cuStreamWaitEvent(stream, plan->fork, 0), "cuStreamWaitEvent", error)) ||
+        !cu_check(cuLaunchKernel(l.step_rows, step_x, rows_y, 1, kPerEnvThreads, 1, 1, 0, stream, step_args, nullptr),
                "cuLaunchKernel(kage_step_rows)", error) ||
-        !check(cuLaunchKernel(l.render_rows, render_x, rows_y, 1, static_cast<unsigned>(l.render_threads), 1, 1,
+        !cu_check(cuLaunchKernel(l.render_rows, render_x, rows_y, 1, static_cast<unsigned>(l.render_threads), 1, 1,
                               static_cast<unsigned>(l.render_smem), stream, render_args, nullptr),
                "cuLaunchKernel(kage_render_rows)", error))
       return false;
-    if (fork && !(check(cuEventRecord(l.done, stream), "cuEventRecord", error) &&
-                  check(cuStreamWaitEvent(main, l.done, 0), "cuStreamWaitEvent", error)))
+    if (fork && !(cu_check(cuEventRecord(l.done, stream), "cuEventRecord", error) &&
+                  cu_check(cuStreamWaitEvent(main, l.done, 0), "cuStreamWaitEvent", error)))
       return false;
   }
   // The other batches' streams after the step, so that their consumers see its outputs.
-  if (!check(cuEventRecord(plan->stepped, main), "cuEventRecord", error)) return false;
+  if (!cu_check(cuEventRecord(plan->stepped, main), "cuEventRecord", error)) return false;
   for (size_t i = 1; i < batches.size(); ++i)
-    if (batches[i]->stream_ != main && !check(cuStreamWaitEvent(batches[i]->stream_, plan->stepped, 0),
+    if (batches[i]->stream_ != main && !cu_check(cuStreamWaitEvent(batches[i]->stream_, plan->stepped, 0),
                                               "cuStreamWaitEvent", error))
       return false;
   return true;

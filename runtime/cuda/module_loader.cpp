@@ -133,6 +133,12 @@ std::optional<std::string> nvrtc_compile(const std::string& source, const std::s
   return cubin;
 }
 
+bool cu_check(CUresult r, const char* what, std::string* error) {
+  if (r == CUDA_SUCCESS) return true;
+  *error = cu_error_text(r, what);
+  return false;
+}
+
 std::string cu_error_text(CUresult r, const char* what) {
   if (r == CUDA_SUCCESS) return {};
   const char* name = nullptr;

@@ -14,6 +14,9 @@ namespace kage {
 /// "what: CUDA error name (message)" for a failed driver call; empty for CUDA_SUCCESS.
 std::string cu_error_text(CUresult r, const char* what);
 
+/// Whether driver call `what` returned CUDA_SUCCESS; if not, its cu_error_text in `error`.
+bool cu_check(CUresult r, const char* what, std::string* error);
+
 /// The primary context of device 0, made current on the calling thread. Null with a message in
 /// `error` when there is no driver or no device (the CPU backend still works then).
 CUcontext cuda_primary_context(std::string* error);

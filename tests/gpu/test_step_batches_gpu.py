@@ -35,15 +35,17 @@ def assert_same_outputs(envs_a, envs_b, step) -> None:
             assert torch.equal(oa[key], ob[key]), (step, key)
 
 
-def test_rows_on_several_streams_equal_each_batch_stepped_alone():
-    streams = [torch.cuda.Stream() for _ in range(4)]
-    together, alone = batches([s.cuda_stream for s in streams]), batches([0] * 4)
+def step_side_by_side(together, alone, steps: int, seed: int, dtype=torch.int64) -> int:
+    """Resets both lists, then steps `together` by kage.step_batches and each batch of `alone` by its own step with
+    the same random rows (made on the default stream), comparing their outputs every 50 steps and past the 500-step
+    truncation; the number of episodes that ended in `together`."""
     for env in together + alone:
         env.reset()
-    generator = torch.Generator(device="cuda").manual_seed(3)
+    generator = torch.Generator(device="cuda").manual_seed(seed)
     finished = 0
-    for step in range(600):  # past the 500-step truncation of every episode
-        actions = torch.randint(0, 8, (4, N), device="cuda", generator=generator)  # on the default stream
+    for step in range(steps):
+        actions = torch.randint(0, 8, (len(together), together[0].num_envs), device="cuda", generator=generator,
+                                dtype=dtype)
         kage.step_batches(together, actions)
         for env, row in zip(alone, actions):
             env.step(row)
@@ -51,6 +53,13 @@ def test_rows_on_several_streams_equal_each_batch_stepped_alone():
         if step % 50 == 0 or step >= 495:
             assert_same_outputs(together, alone, step)
         finished += sum(int(torch.from_dlpack(env.outputs()[4]["_final"]).sum()) for env in together)
+    return finished
+
+
+def test_rows_on_several_streams_equal_each_batch_stepped_alone():
+    streams = [torch.cuda.Stream() for _ in range(4)]
+    together, alone = batches([s.cuda_stream for s in streams]), batches([0] * 4)
+    finished = step_side_by_side(together, alone, 600, seed=3)  # past the 500-step truncation of every episode
     assert finished >= 4 * N  # every environment's episode ended at least once
 
 
@@ -75,17 +84,8 @@ def test_a_pack_of_mixtures_steps_together_as_each_alone():
     streams = [torch.cuda.Stream().cuda_stream for _ in range(8)]
     together = [kage.make_vec(mixture, 40, device="cuda", seed=i, stream=s) for i, s in enumerate(streams)]
     alone = [kage.make_vec(mixture, 40, device="cuda", seed=i) for i in range(8)]
-    for env in together + alone:
-        env.reset()
-    generator = torch.Generator(device="cuda").manual_seed(7)
-    for step in range(520):
-        actions = torch.randint(0, 8, (8, 40), device="cuda", generator=generator, dtype=torch.int32)
-        kage.step_batches(together, actions)
-        for env, row in zip(alone, actions):
-            env.step(row)
-        torch.cuda.synchronize()
-        if step % 100 == 0 or step >= 495:
-            assert_same_outputs(together, alone, step)
+    finished = step_side_by_side(together, alone, 520, seed=7, dtype=torch.int32)
+    assert finished >= 8 * 40  # every environment's episode ended at least once
 
 
 def test_a_bad_action_names_its_batch_and_nothing_steps():

@@ -333,11 +333,11 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
     for flag in PER_RUN_FLAGS:
         if any(arg == flag or arg.startswith(flag + "=") for arg in trainer_args):
             raise SystemExit(f"kage.bench: {flag} is set per run by kage.bench; remove it")
-    from kage.ppo import train
+    from kage.ppo import args as trainer, train
     try:
         probe = train.parse_args(["--train-config-path", args.suite, *trainer_args])  # trainer flags checked now
     except SystemExit as e:
-        prog = "python3 -m kage.ppo.train: "
+        prog = f"{trainer.PROG}: "
         if isinstance(e.code, str) and e.code.startswith(prog):  # a flag the trainer does not have, named here
             raise SystemExit(f"kage.bench: {e.code[len(prog):]}") from None
         raise

@@ -111,6 +111,9 @@ class Args:
         return self.total_timesteps // self.batch_size
 
 
+PROG = "python3 -m kage.ppo.train"  # the trainer's command, which its refusals start with
+
+
 def unknown_argument(parser: argparse.ArgumentParser, word: str) -> str:
     """What is wrong with `word`, the first argument `parser` did not take, and the fix."""
     if not word.startswith("-"):
@@ -130,7 +133,7 @@ PER_RUN = ("train_config_path", "train_config_paths", "train_weights", "train_sc
 def parse_args(argv: Optional[List[str]] = None) -> Args:
     """The flags of Args: --snake-case names, booleans as --flag / --no-flag."""
     # No abbreviations: kage.bench refuses the per-run flags by their full names, which an abbreviation would pass.
-    parser = argparse.ArgumentParser(prog="python3 -m kage.ppo.train", description=DESCRIPTION, allow_abbrev=False)
+    parser = argparse.ArgumentParser(prog=PROG, description=DESCRIPTION, allow_abbrev=False)
     for f in dataclasses.fields(Args):
         flag = "--" + f.name.replace("_", "-")
         default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default
