@@ -153,6 +153,8 @@ ffi::Error launch(const char* call, const JaxConfig& c, const DeviceProgram& p, 
                   CUstream stream) {
   std::string error;
   void* args[] = {&e};
+  const GroupRow* no_rows = nullptr;  // kage_render of this call's own view
+  void* render_args[] = {&no_rows, &e};
   const unsigned grid = static_cast<unsigned>((e.num_envs + kPerEnvThreads - 1) / kPerEnvThreads);
   const int32_t frames = frames_per_block(c.visual, e.num_envs, p.multiprocessors);
   const unsigned render_grid = static_cast<unsigned>((e.num_envs + frames - 1) / frames);
@@ -161,7 +163,7 @@ ffi::Error launch(const char* call, const JaxConfig& c, const DeviceProgram& p, 
       cu_check(cuLaunchKernel(per_env, grid, 1, 1, kPerEnvThreads, 1, 1, 0, stream, args, nullptr), "cuLaunchKernel",
             &error) &&
       cu_check(cuLaunchKernel(p.render, render_grid, 1, 1, static_cast<unsigned>(p.render_threads), 1, 1,
-                           static_cast<unsigned>(p.render_smem), stream, args, nullptr),
+                           static_cast<unsigned>(p.render_smem), stream, render_args, nullptr),
             "cuLaunchKernel(kage_render)", &error))
     return ffi::Error::Success();
   return handler_error(call, error);

@@ -259,8 +259,7 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
     Part p;
     p.first = first;
     for (auto [fn, name] : {std::pair{&p.reset, "kage_reset"}, std::pair{&p.step, "kage_step"},
-                            std::pair{&p.render, "kage_render"}, std::pair{&p.step_rows, "kage_step_rows"},
-                            std::pair{&p.render_rows, "kage_render_rows"}}) {
+                            std::pair{&p.render, "kage_render"}, std::pair{&p.step_rows, "kage_step_rows"}}) {
       *fn = src.module->function(name, error);
       if (!*fn) return std::nullopt;
     }
@@ -272,10 +271,9 @@ std::optional<DeviceBatch> DeviceBatch::create(const std::vector<DevicePartSourc
     p.render_threads = render_threads(src.vp);
     p.render_smem = render_dynamic_smem_bytes(src.vp);
     p.frames_per_block = frames_per_block(src.vp, std::max(src.num_envs, 1), multiprocessors);
-    for (CUfunction render : {p.render, p.render_rows})
-      if (!cu_check(cuFuncSetAttribute(render, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, p.render_smem),
-                 "cuFuncSetAttribute(dynamic shared memory)", error))
-        return std::nullopt;
+    if (!cu_check(cuFuncSetAttribute(p.render, CU_FUNC_ATTRIBUTE_MAX_DYNAMIC_SHARED_SIZE_BYTES, p.render_smem),
+                  "cuFuncSetAttribute(dynamic shared memory)", error))
+      return std::nullopt;
     std::optional<DeviceAssets> assets = upload_assets(src.host_assets, error);
     if (!assets) return std::nullopt;
     p.assets = assets->memory;
@@ -406,8 +404,9 @@ bool DeviceBatch::launch_per_env(CUfunction f, const DeviceEnvs& envs, CUstream 
 
 bool DeviceBatch::launch_render(const Part& p, CUstream stream, std::string* error) {
   if (p.envs.num_envs == 0) return true;
+  const GroupRow* no_rows = nullptr;  // kage_render of the part's own view
   DeviceEnvs arg = p.envs;
-  void* args[] = {&arg};
+  void* args[] = {&no_rows, &arg};
   const unsigned grid = static_cast<unsigned>((p.envs.num_envs + p.frames_per_block - 1) / p.frames_per_block);
   return cu_check(cuLaunchKernel(p.render, grid, 1, 1, static_cast<unsigned>(p.render_threads),
                               1, 1, static_cast<unsigned>(p.render_smem), stream, args, nullptr),

@@ -161,9 +161,8 @@ class DeviceBatch {
     DeviceEnvs envs{};  ///< every per-env pointer offset by `first`; assets the part's own
     CUfunction reset = nullptr;
     CUfunction step = nullptr;
-    CUfunction render = nullptr;
-    CUfunction step_rows = nullptr;    ///< the grouped forms (step_together)
-    CUfunction render_rows = nullptr;
+    CUfunction render = nullptr;       ///< also step_together's, over a table of rows
+    CUfunction step_rows = nullptr;    ///< the grouped step (step_together)
     std::string code;                  ///< DevicePartSource::code
     bool frame_passes = false;         ///< needs_frame_passes of its config (one frame per rendering block)
     int32_t render_threads = 0;

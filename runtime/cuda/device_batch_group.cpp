@@ -73,7 +73,7 @@ GroupPlan* DeviceBatch::group_plan(const std::vector<DeviceBatch*>& batches, std
     const Part& p = *members.front().first;
     GroupLaunch l;
     l.step_rows = p.step_rows;
-    l.render_rows = p.render_rows;
+    l.render = p.render;
     l.first_row = static_cast<int32_t>(rows.size());
     l.row_count = static_cast<int32_t>(members.size());
     l.render_threads = p.render_threads;
@@ -133,16 +133,17 @@ bool DeviceBatch::step_together(const std::vector<DeviceBatch*>& batches, const 
     CUdeviceptr rows = plan->rows + static_cast<CUdeviceptr>(l.first_row) * sizeof(GroupRow);
     ActionRows source = actions;
     void* step_args[] = {&rows, &source};
-    void* render_args[] = {&rows};
+    DeviceEnvs unused{};  // kage_render's own view, read only without rows
+    void* render_args[] = {&rows, &unused};
     const auto rows_y = static_cast<unsigned>(l.row_count);
     const auto step_x = static_cast<unsigned>((l.max_envs + kPerEnvThreads - 1) / kPerEnvThreads);
     const auto render_x = static_cast<unsigned>((l.max_envs + l.frames_per_block - 1) / l.frames_per_block);
     if ((fork && !cu_check(cuStreamWaitEvent(stream, plan->fork, 0), "cuStreamWaitEvent", error)) ||
         !cu_check(cuLaunchKernel(l.step_rows, step_x, rows_y, 1, kPerEnvThreads, 1, 1, 0, stream, step_args, nullptr),
                "cuLaunchKernel(kage_step_rows)", error) ||
-        !cu_check(cuLaunchKernel(l.render_rows, render_x, rows_y, 1, static_cast<unsigned>(l.render_threads), 1, 1,
+        !cu_check(cuLaunchKernel(l.render, render_x, rows_y, 1, static_cast<unsigned>(l.render_threads), 1, 1,
                               static_cast<unsigned>(l.render_smem), stream, render_args, nullptr),
-               "cuLaunchKernel(kage_render_rows)", error))
+               "cuLaunchKernel(kage_render)", error))
       return false;
     if (fork && !(cu_check(cuEventRecord(l.done, stream), "cuEventRecord", error) &&
                   cu_check(cuStreamWaitEvent(main, l.done, 0), "cuStreamWaitEvent", error)))

@@ -68,7 +68,7 @@ struct DeviceEnvs {
 static_assert(__is_trivially_copyable(DeviceEnvs), "DeviceEnvs is a kernel argument");
 
 /// One row of a grouped launch (DeviceBatch::step_together): a batch part that runs the launch's config.
-/// Block row blockIdx.y of kage_step_rows and kage_render_rows works on rows[blockIdx.y].
+/// Block row blockIdx.y of kage_step_rows, and of kage_render given rows, works on rows[blockIdx.y].
 struct GroupRow {
   DeviceEnvs envs;  ///< the part's view, as its own launches see it (its count and report slots included)
   int32_t batch;    ///< the row of the call's actions that holds this part's batch

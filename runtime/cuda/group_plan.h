@@ -10,10 +10,10 @@
 
 namespace kage {
 
-/// One code's launch pair: kage_step_rows and kage_render_rows over rows [first_row, first_row + row_count).
+/// One code's launch pair: kage_step_rows and kage_render over rows [first_row, first_row + row_count).
 struct GroupLaunch {
   CUfunction step_rows = nullptr;
-  CUfunction render_rows = nullptr;
+  CUfunction render = nullptr;
   int32_t first_row = 0;
   int32_t row_count = 0;
   int32_t max_envs = 0;           ///< the largest row: the grid's width

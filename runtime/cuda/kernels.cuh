@@ -178,10 +178,16 @@ __device__ __forceinline__ void step_row_body(const GroupRow* rows, const Action
   count_step(row.envs.actions, row.envs.num_envs);
 }
 
-/// A grouped render's row (blockIdx.y): render_body over the row's part, its view copied into shared memory.
+/// The render kernel's body: render_body over `one`, or, when `rows` is not null, over row blockIdx.y of a
+/// grouped launch; either view is copied into shared memory first. One entry point serves both, since each
+/// inlined copy of render_body costs as much NVRTC and nvcc time as the rest of the module.
 template <class Cfg>
-__device__ __forceinline__ void render_row_body(const GroupRow* rows, GroupRow& row, BlockShared& sh, float* frame) {
-  group_copy_words<BlockGroup>(&row, rows + blockIdx.y, static_cast<int32_t>(sizeof(GroupRow)));
+__device__ __forceinline__ void render_entry_body(const GroupRow* rows, const DeviceEnvs& one, GroupRow& row,
+                                                  BlockShared& sh, float* frame) {
+  if (rows)
+    group_copy_words<BlockGroup>(&row, rows + blockIdx.y, static_cast<int32_t>(sizeof(GroupRow)));
+  else if (threadIdx.x == 0)
+    row.envs = one;
   __syncthreads();
   render_body<Cfg>(row.envs, sh, frame);
 }
@@ -195,22 +201,16 @@ __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n,
 }  // namespace kage
 
 /// Emits the entry points of one config with fixed unmangled names, so that a loader finds them in any
-/// compiled config: kage_reset and kage_step (one thread per environment; any block size),
+/// compiled config: kage_reset and kage_step (one thread per environment; any block size); kage_step_rows,
+/// whose block row y steps rows[y] (GroupRow): several batches' parts of this config in one launch;
 /// kage_render (render_threads() threads and render_dynamic_smem_bytes() bytes of dynamic shared memory
-/// per block, ceil(num_envs / grid) environments per block), kage_sample_actions; and the grouped forms
-/// kage_step_rows and kage_render_rows, which run block row y of their grid on rows[y] (GroupRow): several
-/// batches' parts of this config in one launch. Use once per module.
+/// per block, ceil(num_envs / gridDim.x) environments per block) of `one`, or with `rows` not null of
+/// rows[blockIdx.y]; kage_sample_actions. Use once per module.
 #define KAGE_INSTANTIATE_KERNELS(CFG)                                                                     \
   extern "C" __global__ void kage_reset(const kage::DeviceEnvs e) { kage::reset_body<CFG>(e); }           \
   extern "C" __global__ void kage_step(const kage::DeviceEnvs e) {                                        \
     kage::step_body<CFG>(e);                                                                              \
     kage::count_step(e.actions, e.num_envs);                                                              \
-  }                                                                                                       \
-  extern "C" __global__ void __launch_bounds__(kage::RenderBounds<CFG>::kThreads,                          \
-                                               kage::RenderBounds<CFG>::kMinBlocks) kage_render(const kage::DeviceEnvs e) {              \
-    __shared__ kage::BlockShared sh;                                                                      \
-    extern __shared__ float4 kage_frame[];                                                                \
-    kage::render_body<CFG>(e, sh, reinterpret_cast<float*>(kage_frame));                                  \
   }                                                                                                       \
   extern "C" __global__ void kage_step_rows(const kage::GroupRow* rows, const kage::ActionRows actions) {   \
     __shared__ kage::GroupRow row;                                                                        \
@@ -218,11 +218,11 @@ __device__ __forceinline__ void sample_actions_body(int32_t* actions, int32_t n,
   }                                                                                                       \
   extern "C" __global__ void __launch_bounds__(kage::RenderBounds<CFG>::kThreads,                          \
                                                kage::RenderBounds<CFG>::kMinBlocks)                       \
-      kage_render_rows(const kage::GroupRow* rows) {                                                      \
+      kage_render(const kage::GroupRow* rows, const kage::DeviceEnvs one) {                               \
     __shared__ kage::BlockShared sh;                                                                      \
     __shared__ kage::GroupRow row;                                                                        \
     extern __shared__ float4 kage_frame[];                                                                \
-    kage::render_row_body<CFG>(rows, row, sh, reinterpret_cast<float*>(kage_frame));                      \
+    kage::render_entry_body<CFG>(rows, one, row, sh, reinterpret_cast<float*>(kage_frame));               \
   }                                                                                                       \
   extern "C" __global__ void kage_sample_actions(int32_t* actions, int32_t n, uint64_t seed, uint32_t t) {  \
     kage::sample_actions_body(actions, n, seed, t);                                                       \
