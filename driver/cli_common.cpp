@@ -76,6 +76,7 @@ std::optional<Spec> resolve_file(const char* command, const std::string& file, c
     spec = analyze_file(file, opts.resolve_options(), s, r, d);
     return spec.has_value();
   });
+  if (!ok) hint_shipped(command, "configs", file, io);
   return ok ? spec : std::nullopt;
 }
 
@@ -86,7 +87,10 @@ std::optional<LoweredFile> lower_file(const char* command, const std::string& fi
     loaded = load_lowered(file, opts.resolve_options(), s, r, d);
     return loaded.spec.has_value();
   });
-  if (!ok) return std::nullopt;
+  if (!ok) {
+    hint_shipped(command, "configs", file, io);
+    return std::nullopt;
+  }
   if (!loaded.ok()) {
     io.err << loaded.lower_errors << "kagec " << command << ": the runtime cannot hold this config\n";
     *exit_code = kExitErrors;

@@ -8,6 +8,7 @@
 #include "compiler/basic/diag.h"
 #include "compiler/basic/file_out.h"
 #include "driver/commands.h"
+#include "driver/shipped_names.h"
 #include "compiler/lower/load_lowered.h"
 #include "compiler/sema/resolve.h"
 

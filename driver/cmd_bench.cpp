@@ -51,6 +51,7 @@ int cmd_bench(const std::vector<std::string>& args, CommandIo& io) {
   EnvironmentResult opened = Environment::open(config, options);
   if (!opened.ok()) {
     io.err << opened.warnings << opened.error;
+    hint_shipped("bench", "configs", config, io);
     return kExitErrors;
   }
   CpuEnv& env = opened.env->env();

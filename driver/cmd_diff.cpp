@@ -104,6 +104,8 @@ int cmd_diff(const std::vector<std::string>& args, CommandIo& io) {
   const auto eval = analyze_file(eval_file, opts.resolve_options(), sources, reader, diags);
   print_text(diags, io.err, io.err_is_terminal);
   if (!train || !eval || diags.has_errors()) {
+    hint_shipped("diff", "configs", train_file, io);
+    hint_shipped("diff", "configs", eval_file, io);
     io.err << "kagec diff: fix the errors above first\n";
     return kExitErrors;
   }

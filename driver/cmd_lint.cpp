@@ -22,6 +22,7 @@ int cmd_lint(const std::vector<std::string>& args, CommandIo& io) {
     const size_t e = diags.error_count(), w = diags.warning_count();
     if (e || w) io.err << e << " error" << (e == 1 ? "" : "s") << ", " << w << " warning" << (w == 1 ? "" : "s") << "\n";
   }
+  for (const std::string& f : files) hint_shipped("lint", "configs", f, io);
   return diags.has_errors() ? kExitErrors : kExitOk;
 }
 

@@ -106,6 +106,7 @@ int cmd_render(const std::vector<std::string>& args, CommandIo& io) {
   io.err << opened.warnings;
   if (!opened.ok()) {
     io.err << opened.error;
+    hint_shipped("render", "configs", config, io);
     return kExitErrors;
   }
   CpuEnv& env = opened.env->env();

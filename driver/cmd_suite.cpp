@@ -56,6 +56,7 @@ int cmd_suite(const std::vector<std::string>& args, CommandIo& io) {
   const auto suite = load_suite(manifest, sources, reader, diags, runtime_include_dir() + "/configs");
   if (!suite || diags.has_errors()) {
     print_text(diags, io.err, io.err_is_terminal);
+    hint_shipped("suite", "suites", manifest, io);
     return kExitErrors;
   }
   const fs::path dir = out_dir.empty() ? fs::path("out") / suite->name : fs::path(out_dir);

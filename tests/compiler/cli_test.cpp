@@ -75,6 +75,28 @@ TEST_CASE("kagec lint of a missing file reports file-unreadable", "[cli]") {
   CHECK(r.err.find("[file-unreadable]") != std::string::npos);
 }
 
+TEST_CASE("a shipped name where kagec wants a path is answered with the shipped file's path", "[cli]") {
+  const CliRun lint = kagec({"lint", "filters/4-eval.yaml"});
+  CHECK(lint.code == 1);
+  CHECK(lint.err.find("kagec lint: 'filters/4-eval.yaml' is no file here; kagec takes paths, and the shipped config "
+                      "of that name is ") != std::string::npos);
+  CHECK(lint.err.find("configs/kage_bench/filters/4-eval.yaml\n") != std::string::npos);
+  const CliRun resolve = kagec({"resolve", "throughput/simplest"});
+  CHECK(resolve.code == 1);
+  CHECK(resolve.err.find("configs/throughput/simplest.yaml\n") != std::string::npos);
+  const CliRun suite = kagec({"suite", "kage_bench"});
+  CHECK(suite.code == 1);
+  CHECK(suite.err.find("the shipped suite of that name is ") != std::string::npos);
+  CHECK(suite.err.find("suites/kage_bench.yaml\n") != std::string::npos);
+  // A short name that several shipped configs end with: each is named.
+  const CliRun several = kagec({"lint", "3-eval"});
+  CHECK(several.err.find("the shipped configs of that name are ") != std::string::npos);
+  CHECK(several.err.find("configs/kage_bench/filters/3-eval.yaml") != std::string::npos);
+  CHECK(several.err.find("configs/kage_bench/background/3-eval.yaml") != std::string::npos);
+  // A path that matches nothing shipped gets no hint.
+  CHECK(kagec({"lint", "tests/lint/there_is_no_such_file.yaml"}).err.find("is no file here") == std::string::npos);
+}
+
 TEST_CASE("text diagnostics show the source line, a caret, fix-its and notes", "[cli]") {
   const CliRun r = kagec({"lint", "tests/lint/schema-unknown-key-json.yaml"});
   CHECK(r.code == 1);
