@@ -158,7 +158,9 @@ class SuiteLoader {
       diags_.report(Rule::SuiteInvalid, e->value.range, "'" + key + "' must be a config path or an inline config");
       return std::nullopt;
     }
-    ref.path = join_path(suite.dir, std::get<std::string>(v));
+    const std::optional<std::string> path = find_config(std::get<std::string>(v), suite.dir, false, e->value.range);
+    if (!path) return std::nullopt;
+    ref.path = *path;
     return ref;
   }
 
