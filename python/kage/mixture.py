@@ -8,10 +8,12 @@ weights); the ``N - sum(floors)`` environments left over go one each to the conf
 ``N * w_k / W - floor(N * w_k / W)``, a tie to the earlier config (the largest-remainder method). The arithmetic
 is exact (each weight is the exact value of its float, as ``fractions.Fraction`` reads it), so the split is the
 same on every machine. The environments are numbered config by config: config 0's first, then config 1's, and
-so on; ``info["config"]`` gives each environment's config index.
+so on; ``info["config"]`` gives each environment's config index. A config of positive weight that the split
+leaves without environments (a batch smaller than its weights ask) runs nowhere: that is warned of (UserWarning).
 """
 import math
 import os
+import warnings
 from fractions import Fraction
 from typing import List, Sequence, Tuple
 
@@ -58,6 +60,19 @@ def split(num_envs: int, weights: Sequence[Fraction]) -> Tuple[int, ...]:
     for k in by_remainder[:left]:
         counts[k] += 1
     return tuple(counts)
+
+
+def split_warned(num_envs: int, weights: Sequence[Fraction], configs: Sequence[str], caller: str) -> Tuple[int, ...]:
+    """split(), warning (UserWarning, at the caller's caller) when a config of positive weight gets no environment:
+    it would not run at all, which a batch too small for its weights does without failing."""
+    counts = split(num_envs, weights)
+    unrun = [k for k, (n, w) in enumerate(zip(counts, weights)) if n == 0 and w > 0]
+    if unrun:
+        names = ", ".join(f"configs[{k}] {configs[k]!r} (weight {float(weights[k]):g})" for k in unrun)
+        warnings.warn(f"{caller}: {num_envs} environments split as {list(counts)} leave {names} none, so "
+                      f"{'it runs' if len(unrun) == 1 else 'they run'} nowhere; give more environments or a larger "
+                      "weight (kage.mixture gives the rule)", UserWarning, stacklevel=3)
+    return counts
 
 
 def config_index(counts: Sequence[int]) -> np.ndarray:

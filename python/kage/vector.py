@@ -363,7 +363,8 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
         raise ValueError(f"device={device!r}: use 'cpu' or 'cuda'")
     if not _is_integer(num_envs) or not 0 < num_envs <= MAX_INT32:
         raise ValueError(f"num_envs={num_envs!r}: a positive integer up to {MAX_INT32}")
-    counts = _mixture.split(int(num_envs), _mixture.weights_of(weights, len(configs))) if mixture else None
+    counts = (_mixture.split_warned(int(num_envs), _mixture.weights_of(weights, len(configs)), configs, "kage.make_vec")
+              if mixture else None)
     seed = _seed_value(seed)
     if asset_root is not None:
         if not isinstance(asset_root, (str, bytes, os.PathLike)):

@@ -93,3 +93,8 @@ def test_refusals_are_make_vecs():
     with pytest.raises(TypeError, match="expected the MixtureState"):
         env = kage.jax.make_env(MIX, 3)
         env.step(kage.jax.make_env(NEAR_GOAL, 3).reset(0)[0], jnp.zeros(3, jnp.int32))
+
+
+def test_a_config_the_split_leaves_without_environments_is_warned_of():
+    with pytest.warns(UserWarning, match=r"kage.jax.make_env: 2 environments split as \[1, 1, 0\] leave configs\[2\]"):
+        kage.jax.make_env(MIX, 2)

@@ -1,6 +1,7 @@
 """kage.make_vec over a list of configs (kage.mixture): the split, the mixture against its configs stepped alone
 byte for byte per slice, info["config"], the saved state, and every refusal before anything is made."""
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -216,3 +217,16 @@ def test_the_certificate_names_the_axes_that_differ():
     assert cert["axes"] == ["background", "distractors", "filters", "layout"]
     with pytest.raises(kage.ConfigError, match="certify-mixture-latent"):
         front_end.certify_mixture([NEAR_GOAL, NEAR_GOAL_RED, LONG_EPISODE])
+
+
+def test_a_config_the_split_leaves_without_environments_is_warned_of():
+    # 2 environments over three equal weights: shares 2/3 each, floors 0, the two left over to configs 0 and 1.
+    with pytest.warns(UserWarning, match=r"kage.make_vec: 2 environments split as \[1, 1, 0\] leave configs\[2\] "
+                                         r"'.*near_goal_noisy.yaml' \(weight 1\) none, so it runs nowhere"):
+        with kage.make_vec(MIX, 2) as env:
+            assert env.counts == (1, 1, 0)
+    # A weight of 0 asks for no environment: no warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with kage.make_vec(MIX, 2, weights=[1, 1, 0]) as env:
+            assert env.counts == (1, 1, 0)

@@ -134,7 +134,7 @@ def make_env(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
     configs = mixture.config_list(config)
     if not vector._is_integer(num_envs) or not 0 < num_envs <= vector.MAX_INT32:
         raise ValueError(f"num_envs={num_envs!r}: a positive integer up to {vector.MAX_INT32}")
-    counts = mixture.split(int(num_envs), mixture.weights_of(weights, len(configs)))
+    counts = mixture.split_warned(int(num_envs), mixture.weights_of(weights, len(configs)), configs, "kage.jax.make_env")
     paths = mixture.yaml_configs([resources.config_path(c) for c in configs])
     certificate = front_end.certify_mixture(paths, os.fspath(asset_root) if asset_root else None)
     spec_hash = front_end.mixture_hash([c["spec_sha256"] for c in certificate["configs"]], counts)
