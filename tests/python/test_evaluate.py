@@ -185,6 +185,7 @@ def test_video_has_a_frame_per_step_or_per_stride(run, tmp_path, stride, frames)
     done = evaluate(str(out), "--config", NOISY_SKELETON, "--video", str(gif), "--video-stride", str(stride))
     assert done.returncode == 0, done.stderr
     assert gif.read_bytes()[:6] == b"GIF89a"
+    assert f"({EPISODE_LENGTH} steps, {gif.stat().st_size / 1e6:.1f} MB)" in done.stderr
     with Image.open(gif) as image:
         assert image.n_frames == frames
         width, height = image.size
@@ -199,3 +200,16 @@ def test_video_needs_one_config_and_a_known_format(run, tmp_path):
     assert two.returncode == 2 and "exactly one --config" in two.stderr
     other = evaluate(str(out), "--config", NOISY_SKELETON, "--video", str(tmp_path / "a.avi"))
     assert other.returncode != 0 and "write a .gif" in other.stderr
+
+
+def test_a_large_video_says_how_to_make_it_smaller(tmp_path):
+    from kage.ppo import video
+    small, large = tmp_path / "small.gif", tmp_path / "large.gif"
+    small.write_bytes(b"x" * 1000)
+    large.write_bytes(b"x" * (video.LARGE_VIDEO + 1))
+    assert video.size_note(str(small)) == "0.0 MB"
+    assert video.size_note(str(large)) == ("10.5 MB; --video-stride K keeps every K-th step, and an .mp4 (ffmpeg) is "
+                                           "many times smaller")
+    mp4 = tmp_path / "large.mp4"
+    large.rename(mp4)
+    assert video.size_note(str(mp4)) == "10.5 MB; --video-stride K keeps every K-th step"

@@ -264,7 +264,8 @@ def evaluate_command(argv: Optional[List[str]]) -> int:
                               device=options.device, asset_root=options.asset_root,
                               use_frame_stack=spec["use_frame_stack"], greedy=options.greedy,
                               stride=options.video_stride)
-        print(f"kage.ppo.evaluate: wrote {options.video} ({length} steps)", file=sys.stderr)
+        print(f"kage.ppo.evaluate: wrote {options.video} ({length} steps, {video.size_note(options.video)})",
+              file=sys.stderr)
     return 0
 
 

@@ -20,6 +20,7 @@ from kage.util.files import atomic_write
 
 FPS = 25  # a GIF counts time in hundredths of a second: 40 ms a frame is exact
 PANEL_WIDTH = 190
+LARGE_VIDEO = 10 << 20  # bytes: a video past this says how to make it smaller
 
 
 def check_path(path: str) -> None:
@@ -107,6 +108,18 @@ def write_video(path: str, images: List) -> None:
     if done.returncode != 0:
         raise SystemExit(f"kage: ffmpeg could not write {path}: {done.stderr.decode(errors='replace').strip()}")
     os.replace(tmp, path)
+
+
+def size_note(path: str) -> str:
+    """The written video's size, and past LARGE_VIDEO how to make the next one smaller: a GIF of frames that
+    change in every pixel (pixel noise) hardly compresses, about 50 kB a frame."""
+    size = os.path.getsize(path)
+    note = f"{size / 1e6:.1f} MB"
+    if size > LARGE_VIDEO:
+        note += "; --video-stride K keeps every K-th step"
+        if path.lower().endswith(".gif"):
+            note += ", and an .mp4 (ffmpeg) is many times smaller"
+    return note
 
 
 def record(agent, run: int, config: str, seed: int, path: str, title: str, **options) -> int:
