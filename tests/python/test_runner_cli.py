@@ -55,6 +55,32 @@ def test_a_misspelt_trainer_flag_is_named_in_one_line(tmp_path):
     assert not (tmp_path / "bench").exists()
 
 
+@pytest.mark.parametrize("flags, message", [
+    (["--augment", "kage.ppo.augment:colour_jitter"], "did you mean 'color_jitter'"),
+    (["--agent", "kage.ppo.agent:nature_cn"], "--agent kage.ppo.agent:nature_cn"),
+    (["--augment", "tests_plugin_that_is_not_there:fn"], "cannot import 'tests_plugin_that_is_not_there'"),
+])
+def test_a_plug_in_every_run_would_refuse_is_refused_before_any_run(tmp_path, flags, message):
+    suite = write_suite(tmp_path)
+    with pytest.raises(SystemExit) as caught:
+        run.main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *TINY_TRAINING, *flags])
+    assert caught.value.code.startswith("kage.bench: ") and message in caught.value.code
+    assert caught.value.code.endswith("kage.bench: no run started; fix the flag and run again")
+    assert not (tmp_path / "bench").exists()  # nothing recorded: the corrected flag starts afresh
+
+
+def test_a_schedule_stage_after_the_runs_end_is_refused_before_any_run(tmp_path):
+    schedule = tmp_path / "late.yaml"
+    schedule.write_text(f"- start: 1\n  configs: [{NOISY_SKELETON}]\n- start: 50\n  configs: [{NOISY_SKELETON}]\n")
+    suite = tmp_path / "suite.yaml"
+    suite.write_text(f"suite: late\npairs:\n  - name: late\n    axis: background\n    train: {{schedule: {schedule}}}\n"
+                     f"    eval: {NOISY_SKELETON}\n")
+    with pytest.raises(SystemExit) as caught:
+        run.main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *TINY_TRAINING])
+    assert "whose stages[1] starts at iteration 50, after the runs' last (1)" in caught.value.code
+    assert not (tmp_path / "bench").exists()
+
+
 def sbatch_lines(script: str):
     return [line for line in script.splitlines() if line.startswith("#SBATCH ")]
 

@@ -38,6 +38,7 @@ import sys
 import time
 from typing import Dict, List, Optional
 
+import kage
 from kage import front_end, resources
 from kage.ppo import plugins
 from kage.bench import dry_run, gpus, run_state, tasks
@@ -356,11 +357,42 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
         units = share_training(units, report)
     for unit in units:
         check_unit_name(unit.name)
+    check_before_runs(probe, units)
     for p in report["pairs"]:
         if not p["certified"] and any(p["pair"] == q["pair"] for u in units for q in u.pairs):
             print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
     return Bench(suite, out, args.seeds, args.pairs, args.pack, trainer_args, units, seeds,
                  probe.num_iterations * probe.batch_size, probe.device, args.share_training, report)
+
+
+def check_before_runs(probe, units) -> None:
+    """What every run's trainer would refuse at its start, refused once here before any run starts (else each run
+    fails alike, and DIR keeps the flags that failed): a schedule stage after the runs' last iteration, and the
+    plug-ins (--agent built, --augment called once on blank frames) on the CPU at the first config's shape."""
+    for unit in units:
+        starts = [stage["start"] for stage in unit.training.get("stages", [])]
+        late = [i for i, start in enumerate(starts) if start > probe.num_iterations]
+        if late:
+            raise SystemExit(f"kage.bench: {unit.name} trains on {unit.train}, whose stages[{late[0]}] starts at "
+                             f"iteration {starts[late[0]]}, after the runs' last ({probe.num_iterations}): raise "
+                             "--total-timesteps, or start the stage earlier")
+    if probe.agent == plugins.BASELINE_AGENT and not probe.augment:
+        return
+    import torch
+    with kage.make_vec(units[0].train_configs[0], 1, threads=1) as env:
+        height, width, channels = env.single_observation_space.shape
+        num_actions = int(env.single_action_space.n)
+    shape = (height, width, channels * (4 if probe.use_frame_stack else 1))
+    cpu = torch.device("cpu")
+    try:
+        plugins.build_agent(probe.agent, shape, num_actions, [0], cpu, None)
+        augment = plugins.load_augment(probe.augment)
+        if augment:
+            plugins.check_augment(augment, probe.augment, (1, 2, *shape), cpu)
+    except SystemExit as e:
+        trainer = "kage.ppo.train: "  # the plug-ins' refusals name the trainer
+        text = e.code[len(trainer):] if isinstance(e.code, str) and e.code.startswith(trainer) else e.code
+        raise SystemExit(f"kage.bench: {text}\nkage.bench: no run started; fix the flag and run again") from None
 
 
 def record(bench: Bench) -> Bench:
