@@ -150,6 +150,8 @@ SCHEDULES = [
     ("- start: 1\n  configs: [{a}, {b}]\n  weights: [1, -2]\n", ":3: stages[0].weights[1]=-2: a finite number >= 0"),
     ("- start: 1\n  configs: [{a}]\n  weight: [1]\n", ":3: stages[0]: unknown key 'weight'"),
     ("start: 1\n", ":1: a schedule is a YAML list of stages"),
+    ("", ":1: a schedule is a YAML list of stages"),
+    ("- start: 1\n  configs: [{a}]\n  configs: [{b}]\n", ":3: key 'configs' appears twice in one mapping"),
     ("- start: 1\n  configs: [{a}]\n- start: 9\n  configs: [{b}]\n", ":3: stages[1].start 9, but the run has 4 iterations"),
     ("- start: 1\n  configs: [{a}]\n- start: 2\n  configs: [{long}]\n", "certify-mixture-latent"),
 ]

@@ -121,8 +121,12 @@ def read_schedule(path: str) -> List[Stage]:
         raise ScheduleError(f"{path}{line}: not YAML ({getattr(e, 'problem', None) or e}): write the schedule as a "
                             "YAML list of stages") from None
     if not isinstance(value, list) or not value:
-        raise ScheduleError(f"{path}:{_line(root)}: a schedule is a YAML list of stages (each with start, configs "
-                            "and optional weights)")
+        raise ScheduleError(f"{path}:{_line(root) if root is not None else 1}: a schedule is a YAML list of stages "
+                            "(each with start, configs and optional weights)")
+    duplicate = _duplicate_key(root)
+    if duplicate is not None:
+        raise ScheduleError(f"{path}:{_line(duplicate)}: key {duplicate.value!r} appears twice in one mapping: YAML "
+                            "would keep only the last; write each key once")
     base = os.path.dirname(os.path.abspath(path))
     stages: List[Stage] = []
     for i, (node, stage) in enumerate(zip(root.value, value)):
@@ -174,6 +178,26 @@ def _stage(path: str, base: str, i: int, node, stage) -> Stage:
 
 def _line(node) -> int:
     return node.start_mark.line + 1
+
+
+def _duplicate_key(node):
+    """The first key node that repeats a key of its mapping, anywhere under `node`, or None (as kagec's
+    yaml-duplicate-key rule, which the suite's copy of a schedule meets)."""
+    if isinstance(node, yaml.MappingNode):
+        seen = set()
+        for key, value in node.value:
+            if getattr(key, "value", None) in seen:
+                return key
+            seen.add(getattr(key, "value", None))
+            found = _duplicate_key(value)
+            if found is not None:
+                return found
+    elif isinstance(node, yaml.SequenceNode):
+        for item in node.value:
+            found = _duplicate_key(item)
+            if found is not None:
+                return found
+    return None
 
 
 def _key(node, name: str):
