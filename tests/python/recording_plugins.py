@@ -1,7 +1,7 @@
 """Plug-ins for the augmentation modes' tests (tests/python/test_augment_modes.py): an augmentation that marks
 the frames it returns, and a packable network that records, for every call, how many frames it saw, how many
 carried the mark, and whether a gradient was being taken (an update) or not (a rollout, a bootstrap value or an
-evaluation)."""
+evaluation); and one that returns a view of its input."""
 import torch
 import torch.nn as nn
 
@@ -14,6 +14,11 @@ def mark(obs, uniform):
     out = obs.clone()
     out[..., 0, :2, :3] = MARK.to(obs.device).view(2, 3)
     return out
+
+
+def transposed(obs, uniform):
+    """A valid augmentation (square frames keep their shape) whose result is a view of its input."""
+    return obs.transpose(-3, -2)
 
 
 def is_marked(frames: torch.Tensor) -> torch.Tensor:

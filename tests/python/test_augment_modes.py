@@ -139,6 +139,14 @@ def test_evaluations_see_plain_frames_and_each_mode_its_own(tmp_path, mode):
     assert logged["augment_mode"] == mode and logged["drac_coef"] == 0.1
 
 
+def test_an_augmentation_that_returns_a_view_of_its_frames_trains_in_each_mode(tmp_path):
+    flags = [f for f in FLAGS if f != "recording_plugins:mark"]
+    at = flags.index("--augment")
+    flags[at + 1:at + 1] = ["recording_plugins:transposed"]
+    for mode in ("drac", "rollout", "update"):
+        assert train.main(flags + ["--augment-mode", mode, "--out", str(tmp_path / mode)]) == 0
+
+
 def test_augment_mode_defaults_to_drac(tmp_path):
     assert train.main(FLAGS + ["--out", str(tmp_path / "run")]) == 0
     assert json.loads((tmp_path / "run" / "run.json").read_text())["args"]["augment_mode"] == "drac"
@@ -255,7 +263,12 @@ BASE = ["--train-config-path", NOISY_SKELETON, "--device", "cpu", "--threads", "
     (["--augment", "kage.ppo.augment:grayscale", "--drac-coef", "-0.1"], "--drac-coef -0.1"),
     (["--augment", "kage.ppo.augment:grayscale", "--drac-coef", "nan"], "--drac-coef nan"),
     (["--augment-mode", "rollout"], "--augment-mode rollout needs --augment"),
-], ids=["unknown-mode", "negative-coef", "nan-coef", "mode-without-augment"])
+    (["--drac-coef", "0.5"], "--drac-coef 0.5 weighs DrAC's regularisers, which run only with --augment under "
+                             "--augment-mode drac (the default): drop --drac-coef"),
+    (["--augment", "kage.ppo.augment:grayscale", "--augment-mode", "rollout", "--drac-coef", "0.5"],
+     "(the default), not rollout: drop --drac-coef"),
+], ids=["unknown-mode", "negative-coef", "nan-coef", "mode-without-augment", "coef-without-augment",
+        "coef-under-rollout"])
 def test_bad_mode_flags_are_refused_in_one_line_before_anything_is_written(tmp_path, capsys, flags, says):
     out = tmp_path / "run"
     with pytest.raises(SystemExit) as caught:

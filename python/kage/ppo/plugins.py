@@ -187,6 +187,8 @@ def augment_frames(fn: Callable, reference: str, frames: torch.Tensor, uniform: 
     problem = augmented_problem(out, expected, frames.device)
     if problem:
         raise SystemExit(f"kage.ppo.train: --augment {reference}: {problem}")
+    if out is not frames and out.untyped_storage().data_ptr() == frames.untyped_storage().data_ptr():
+        out = out.clone()  # a view of its input (a transpose, a slice): its own memory, for the copy into the rollout
     return out
 
 
