@@ -14,6 +14,8 @@ from typing import List, Optional, Tuple
 from kage import resources
 from kage.ppo import plugins, schedule
 
+DRAC_COEF = 0.1  # DrAC's weight of its regularisers, its paper's default
+
 DESCRIPTION = ("PPO-CNN baseline of KAGE-Bench: train on one config, evaluate on it and on one or more others "
                "(kage-ppo-baseline.md)")
 
@@ -52,7 +54,7 @@ class Args:
                 "regularisers), rollout (the policy acts on augmented frames, and the update reuses them) or update "
                 "(the update's minibatches only: unsound for strong augmentations, kept for comparison)",
         "choices": ("drac", "rollout", "update")})
-    drac_coef: float = field(default=0.1, metadata={
+    drac_coef: float = field(default=DRAC_COEF, metadata={
         "help": "weight of DrAC's regularisers under --augment-mode drac (alpha_r; 0.1 in Raileanu et al. 2021)"})
     # PPO (§2.1: the defaults of ppo_jax.py; the benchmark overrides none)
     total_timesteps: int = field(default=25_000_000, metadata={"help": "environment steps of the run"})
@@ -296,6 +298,11 @@ def validate(args: Args) -> List[str]:
                         "kage.ppo.augment:color_jitter), or drop --augment-mode")
     elif args.augment_mode not in (None, "drac", "rollout", "update"):
         problems.append(f"--augment-mode {args.augment_mode!r}: use drac, rollout or update")
+    mode = args.augment_mode or ("drac" if args.augment else None)
+    if args.drac_coef != DRAC_COEF and mode != "drac":
+        problems.append(f"--drac-coef {args.drac_coef} weighs DrAC's regularisers, which run only with --augment "
+                        f"under --augment-mode drac (the default){f', not {mode}' if mode else ''}: drop --drac-coef, "
+                        "or train with DrAC")
     if args.triton_conv and args.device == "cpu":
         problems.append("--triton-conv is for --device cuda")
     if args.triton_conv and not args.fused_input:
