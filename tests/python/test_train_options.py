@@ -6,7 +6,7 @@ import json
 import pytest
 
 from kage.ppo import args as trainer_args, train
-from support import CONFIGS, NEAR_GOAL
+from support import CONFIGS, LONG_EPISODE, NEAR_GOAL
 
 OPTIONS = ["--use-frame-stack", "--normalize-reward", "--bootstrap-truncation", "--anneal-lr", "--ent-coef-anneal",
            "--channels-last", "--eval-greedy"]
@@ -85,3 +85,16 @@ def test_episodes_shorter_than_a_rollout_are_all_counted(tmp_path):
     assert all(r["train/avg_completed_episodic_length"] == 40 for r in rows)
     assert all("train/avg_passed_distance" in r for r in rows)
     assert (out / "summary.json").exists()
+
+
+def test_an_eval_config_that_changes_the_hidden_game_is_warned_of(tmp_path, capsys):
+    out = tmp_path / "run"
+    train.train([train.parse_args([
+        "--train-config-path", NEAR_GOAL, "--eval-config-path", LONG_EPISODE, "--device", "cpu", "--threads", "1",
+        "--total-timesteps", "64", "--num-envs", "1", "--num-steps", "64", "--num-minibatches", "2",
+        "--update-epochs", "1", "--run-eval-every", "0", "--out", str(out)])])
+    err = capsys.readouterr().err
+    assert f"kage.ppo.train: warning: eval config long_episode.yaml ({LONG_EPISODE})" in err
+    assert "is not certified against the train config: latent keys change (the hidden game differs)" in err
+    assert "(certificates/long_episode.yaml.json)" in err
+    assert json.loads((out / "certificates" / "long_episode.yaml.json").read_text())["certified"] is False

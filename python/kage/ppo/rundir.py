@@ -339,6 +339,10 @@ def describe_or_check(path: str, args, configs: List[Tuple[str, str]], specs: Di
         if label not in {training_label(i) for i in range(len(training))}:
             certificate = front_end.certify(first_train_config(args), config, args.asset_root)
             write_json(os.path.join(path, "certificates", f"{safe(label)}.json"), certificate)
+            if not certificate["certified"]:  # a pair that is no visual shift: its scores would read as one
+                print(f"kage.ppo.train: warning: eval config {label} ({config}) is not certified against the train "
+                      f"config: {'; '.join(certificate['problems'])}; its scores do not measure a visual shift "
+                      f"(certificates/{safe(label)}.json)", file=sys.stderr)
     write_json(run_json, {
         "kage_run": 1, "args": json_args(args), "argv": sys.argv, "configs": described, "stages": stages,
         "code_version": code_version(), "python": sys.version.split()[0], "torch": torch.__version__,
