@@ -1,6 +1,7 @@
 """SIGTERM (a scheduler's preemption, `timeout`) stops a run without losing work: kage.bench run passes it
 to its training process, which finishes the iteration, checkpoints it (even with periodic checkpoints off)
-and exits; kage.bench run exits 143 and the same command then resumes, and the run ends exactly as an uninterrupted one."""
+and exits; kage.bench run exits 143 (130 for Ctrl-C) and the same command then resumes, and the run ends exactly as an
+uninterrupted one."""
 import json
 import signal
 import subprocess
@@ -58,3 +59,16 @@ def test_sigterm_checkpoints_and_resumes(tmp_path):
     assert resumed.returncode == 0, output
     assert f"after iteration {checkpointed}" in (run_dir / "train.log").read_text()
     assert rows(run_dir) == rows(whole / "runs" / "background" / "1" / "seed_1")
+
+
+def test_ctrl_c_stops_the_runner_with_the_shells_code_for_sigint(tmp_path):
+    run_dir = tmp_path / "runs" / "background" / "1" / "seed_1"
+    child = bench_run(tmp_path)
+    deadline = time.time() + 600
+    while time.time() < deadline and child.poll() is None and train_rows(run_dir) < 1:
+        time.sleep(0.05)
+    assert child.poll() is None, "the run ended before it could be stopped"
+    child.send_signal(signal.SIGINT)
+    output = child.communicate(timeout=300)[0]
+    assert child.returncode == 128 + signal.SIGINT, output  # 130, as the trainer's own Ctrl-C
+    assert "kage.bench run: stopped background/1 seed 1; run again (or requeue) to resume" in output

@@ -476,12 +476,13 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
                         run_state.mark(run_dirs, "running", task=task, log=log_path)
                         beat = time.monotonic()
                     time.sleep(1.0)
-            except (Stop, KeyboardInterrupt):
+            except (Stop, KeyboardInterrupt) as stopped:
                 stop_children([child])
                 run_state.mark(run_dirs, "stopped", task=task, log=log_path)
                 print(f"\nkage.bench run: stopped {', '.join(labels)}; run again (or requeue) to resume them from "
                       "their last checkpoints", file=sys.stderr, flush=True)
-                return 128 + signal.SIGTERM
+                # The shell's convention for "ended by signal N", as the trainer's: Ctrl-C 130, SIGTERM 143.
+                return 128 + (signal.SIGINT if isinstance(stopped, KeyboardInterrupt) else signal.SIGTERM)
         if child.returncode == 0:
             run_state.mark(run_dirs, "done", task=task, log=log_path)
         else:
