@@ -189,6 +189,13 @@ class SuiteLoader {
       return load_schedule(join_path(suite.dir, std::get<std::string>(v)), e->value.find("schedule")->value.range,
                            mixture);
     }
+    if (e && e->value.is_map() && e->value.entries.size() == 1 &&
+        suggest(e->value.entries[0].key, {"schedule"})) {  // {schedul: PATH}: not an inline config
+      diags_.report(Rule::SuiteInvalid, e->value.entries[0].key_range,
+                    "unknown key '" + e->value.entries[0].key + "' in 'train'; did you mean 'schedule'? (write "
+                    "{schedule: PATH}; any other mapping here is an inline config)");
+      return false;
+    }
     auto one = config_of(map, "train", suite);
     if (!one) return false;
     ref = std::move(*one);
