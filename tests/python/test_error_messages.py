@@ -8,14 +8,16 @@ import io
 import json
 import os
 import shutil
+import socket
 import subprocess
 import sys
+import time
 
 import pytest
 
 from kage.bench import status
 from kage.ppo import checkpoint, train
-from support import CONFIGS, NOISY_SKELETON, ROOT, TINY_TRAINING
+from support import CONFIGS, NOISY_SKELETON, ROOT, TINY_TRAINING, dead_pid
 
 FLAGS = ["--train-config-path", NOISY_SKELETON, "--device", "cpu", "--threads", "1", "--total-timesteps", "64",
          "--num-envs", "2", "--num-steps", "16", "--num-minibatches", "2", "--update-epochs", "1",
@@ -151,6 +153,24 @@ def test_a_damaged_bench_state_does_not_abort_status(tmp_path):
     for unit in ("list", "syntax", "no_time", "text_time", "no_host"):
         line = next(line for line in text.splitlines() if f"{unit} seed 1" in line)
         assert "bench_state.json" in line and "rewritten" in line, line
+
+
+def test_status_calls_a_fresh_running_run_interrupted_when_its_runner_here_is_gone(tmp_path):
+    bench = tmp_path / "bench"
+    here = socket.gethostname()
+    runs = {"alive": {"state": "running", "time": time.time(), "host": here, "pid": os.getpid()},
+            "killed": {"state": "running", "time": time.time(), "host": here, "pid": dead_pid()},
+            "elsewhere": {"state": "running", "time": time.time(), "host": here + "-other", "pid": dead_pid()}}
+    for unit, content in runs.items():
+        (bench / "runs" / unit / "seed_1").mkdir(parents=True)
+        (bench / "runs" / unit / "seed_1" / "bench_state.json").write_text(json.dumps(content))
+    (bench / "bench.json").write_text(json.dumps({"units": list(runs), "seeds": [1]}))
+    out = io.StringIO()
+    found = status.status(str(bench), out)
+    assert found["running"] == ["alive seed 1", "elsewhere seed 1"]  # another host's process cannot be looked at
+    assert found["interrupted"] == ["killed seed 1"]
+    line = next(line for line in out.getvalue().splitlines() if "killed seed 1" in line)
+    assert f"its runner (pid {runs['killed']['pid']}, this host) is gone (killed?)" in line, line
 
 
 def crafted(run, change):

@@ -2,6 +2,7 @@
 number of them, on any hosts: a Slurm array, GPU workers, plain runs): runs done, running, failed (with
 the last error of each), stopped or killed (they resume when run again), and not started."""
 import os
+import socket
 import time
 from typing import Dict, List, TextIO
 
@@ -9,7 +10,7 @@ from kage.bench import run_state
 from kage.bench.records import bench_problem
 from kage.bench.run import checkpoint_iteration
 from kage.bench.tasks import run_dir
-from kage.util.files import read_json_record
+from kage.util.files import process_alive, read_json_record
 from kage.util.text import plural
 
 ORDER = ("done", "running", "failed", "interrupted", "not started")
@@ -33,6 +34,9 @@ def classify(path: str, now: float) -> tuple:
         (f", Slurm job {state['slurm_job']}" if state.get("slurm_job") else "")
     age = now - state["time"]
     if state["state"] == "running" and age <= run_state.STALE_S:
+        pid = state.get("pid")
+        if state["host"] == socket.gethostname() and isinstance(pid, int) and not process_alive(pid):
+            return "interrupted", f"its runner (pid {pid}, this host) is gone (killed?); {at}; {where}"
         return "running", f"{at}; {where}"
     if state["state"] == "failed":
         return "failed", (f"exit {state.get('exit_code', '?')} ({where}, log {state.get('log', '?')}): "
