@@ -63,6 +63,7 @@ def test_compare_by_hand(two):
     out = a / "compare"
     md = (out / "compare.md").read_text()
     assert md.startswith("# hand-made: A vs B")
+    assert "**A**: `" in md and "trainer flags none (the defaults); **B**" in md
     assert "| axis | pairs | P(A > B) |" in md and f"| background | 2 | {(14 / 18):.2f} [" in md
     assert "| background | 0.45 [" in md
     with open(out / "compare.csv") as f:
@@ -80,7 +81,10 @@ def test_compare_by_hand(two):
 def test_three_methods_give_each_two(two, tmp_path):
     a, b = two
     c = method(tmp_path / "C", {"background/1": [0.9] * 3, "background/2": [0.9] * 3, "layout/1": [0.9] * 3})
+    bench = json.loads((c / "bench.json").read_text())
+    (c / "bench.json").write_text(json.dumps({**bench, "trainer_args": ["--augment", "kage.ppo.augment:grayscale"]}))
     result = compare.compare([str(a), str(b), str(c)], names=["base", "shift", "mine"], reps=500)
+    assert "results, trainer flags `--augment kage.ppo.augment:grayscale`." in (a / "compare" / "compare.md").read_text()
     assert {(r["x"], r["y"]) for r in result["improvement"]} == {("base", "shift"), ("base", "mine"),
                                                                 ("shift", "mine")}
     assert "P(base > mine)" in (a / "compare" / "compare.md").read_text()

@@ -77,6 +77,7 @@ class Method:
     trains_on: List[dict] = field(default_factory=list)  # what it trains on for the pairs compared (trains_on)
     last_steps: List[int] = field(default_factory=list)  # under --max-step, its runs' last evaluation steps scored
     training: List[training_runs.Outcome] = field(default_factory=list)  # the training runs behind its results
+    trainer_flags: List[str] = field(default_factory=list)  # bench.json's trainer_args: what sets the methods apart
     estimates: dict = field(default_factory=dict)
 
 
@@ -127,7 +128,8 @@ def load(bench_dir: str, name: str, protocol: str, max_step: Optional[int] = Non
     ran = {p["pair"] for u in units if not u.is_sweep for p in u.pairs}
     return Method(name, bench_dir, suite, sorted(seeds), json.loads(schedules.pop()) if schedules else {}, units,
                   runs, {(r["pair"], r["seed"]) for r in levels["runs"]},
-                  {p["pair"]: p for p in suite["pairs"] if p["pair"] in ran})
+                  {p["pair"]: p for p in suite["pairs"] if p["pair"] in ran},
+                  trainer_flags=list(bench.get("trainer_args") or []))
 
 
 def choose_seeds(methods: List[Method], wanted: Optional[List[int]]) -> List[int]:
@@ -377,7 +379,9 @@ def markdown(methods: List[Method], rows: List[dict], result: dict) -> str:
     protocol = result["protocol"]
     done = "finished (pair, seed) results" if protocol["max_step"] is None else \
         f"(pair, seed) results finished or logged past step {protocol['max_step']}"
-    listed = "; ".join(f"**{m.name}**: `{m.bench_dir}`, {len(m.results)} {done}" for m in methods)
+    listed = "; ".join(f"**{m.name}**: `{m.bench_dir}`, {len(m.results)} {done}, trainer flags "
+                       f"{'`' + ' '.join(m.trainer_flags) + '`' if m.trainer_flags else 'none (the defaults)'}"
+                       for m in methods)
     left_out = [left_out_text(m) for m in methods if m.left_out]
     pairs_out = [pairs_text(m) for m in methods if m.pairs_left_out]
     chosen = result["pairs_chosen"]
