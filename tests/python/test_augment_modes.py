@@ -267,8 +267,10 @@ BASE = ["--train-config-path", NOISY_SKELETON, "--device", "cpu", "--threads", "
                              "--augment-mode drac (the default): drop --drac-coef"),
     (["--augment", "kage.ppo.augment:grayscale", "--augment-mode", "rollout", "--drac-coef", "0.5"],
      "(the default), not rollout: drop --drac-coef"),
+    (["--augment", "kage.ppo.augment:grayscale", "--augment=kage.ppo.augment:color_jitter"],
+     "--augment given 2 times: a run takes one augmentation; to combine several, write one function that calls each"),
 ], ids=["unknown-mode", "negative-coef", "nan-coef", "mode-without-augment", "coef-without-augment",
-        "coef-under-rollout"])
+        "coef-under-rollout", "two-augments"])
 def test_bad_mode_flags_are_refused_in_one_line_before_anything_is_written(tmp_path, capsys, flags, says):
     out = tmp_path / "run"
     with pytest.raises(SystemExit) as caught:

@@ -8,6 +8,7 @@ import importlib.util
 import json
 import math
 import os
+import sys
 from dataclasses import dataclass, field
 from typing import List, Optional, Tuple
 
@@ -15,6 +16,11 @@ from kage import resources
 from kage.ppo import plugins, schedule
 
 DRAC_COEF = 0.1  # DrAC's weight of its regularisers, its paper's default
+
+# Flags whose repetition reads as "both" but would keep the last: refused, with what to do instead.
+ONE_EACH = {"--augment": "a run takes one augmentation; to combine several, write one function that calls each "
+                         "(fn(obs, uniform), README: --augment)",
+            "--agent": "a run trains one network; give one --agent"}
 
 DESCRIPTION = ("PPO-CNN baseline of KAGE-Bench: train on one config, evaluate on it and on one or more others "
                "(kage-ppo-baseline.md)")
@@ -149,6 +155,11 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
             parser.add_argument(flag, type=kind, default=default, help=f.metadata["help"],
                                 choices=f.metadata.get("choices"))
     parser.add_argument("--pack", help="train the runs listed in this JSON file together (written by kage.bench)")
+    given = sys.argv[1:] if argv is None else argv
+    for flag, one in ONE_EACH.items():  # argparse keeps the last silently, where a user may expect them combined
+        times = sum(a == flag or a.startswith(flag + "=") for a in given)
+        if times > 1:
+            parser.error(f"{flag} given {times} times: {one}")
     known, extras = parser.parse_known_args(argv)
     if extras:  # one line naming the nearest flag, instead of argparse's usage block
         raise SystemExit(f"{parser.prog}: {unknown_argument(parser, extras[0])}")
