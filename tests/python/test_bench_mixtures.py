@@ -96,3 +96,14 @@ def test_report_reads_a_mixture_units_runs(tmp_path):
     assert row["train_spec"] == "m" * 64  # the mixture's identity: its configs' Specs and weights
     assert row["metrics"]["success_once"]["train"]["mean"] == 0.8
     assert row["metrics"]["success_once"]["eval"]["mean"] == 0.2
+
+
+def test_a_mixture_split_that_leaves_configs_untrained_is_warned_of_before_any_run(tmp_path, capsys):
+    # filters/1 of the leave-one-out suite trains on 9 configs at equal weights: 2 environments go to the first two.
+    assert run.main(["kage_bench_loo", "--pairs", "filters/1", "--seeds", "1", "--out", str(tmp_path / "b"),
+                     "--dry-run", "--device", "cpu", "--num-envs", "2", "--num-steps", "128",
+                     "--total-timesteps", "256"]) == 0
+    err = capsys.readouterr().err
+    assert "kage.bench: warning: filters/1: --num-envs 2 split over stages[0]'s 9 configs as [1, 1, 0, 0, 0, 0, 0, " \
+           "0, 0] leaves " in err
+    assert "configs/kage_bench/filters/9-eval.yaml without environments: they do not train; raise --num-envs" in err

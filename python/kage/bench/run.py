@@ -358,6 +358,7 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
     for unit in units:
         check_unit_name(unit.name)
     check_before_runs(probe, units)
+    warn_unrun_configs(probe.num_envs, units)
     for p in report["pairs"]:
         if not p["certified"] and any(p["pair"] == q["pair"] for u in units for q in u.pairs):
             print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
@@ -393,6 +394,22 @@ def check_before_runs(probe, units) -> None:
         trainer = "kage.ppo.train: "  # the plug-ins' refusals name the trainer
         text = e.code[len(trainer):] if isinstance(e.code, str) and e.code.startswith(trainer) else e.code
         raise SystemExit(f"kage.bench: {text}\nkage.bench: no run started; fix the flag and run again") from None
+
+
+def warn_unrun_configs(num_envs: int, units) -> None:
+    """A warning, here rather than in each run's train.log, for each mixture stage whose split of --num-envs
+    leaves a config of positive weight without environments (kage.mixture's rule): it would not train at all."""
+    from fractions import Fraction
+    from kage import mixture
+    for unit in units:
+        for i, stage in enumerate(unit.training.get("stages", [])):
+            weights = [Fraction(c["weight"]) for c in stage["configs"]]
+            counts = mixture.split(num_envs, weights)
+            unrun = [c["name"] for c, n, w in zip(stage["configs"], counts, weights) if n == 0 and w > 0]
+            if unrun:
+                print(f"kage.bench: warning: {unit.name}: --num-envs {num_envs} split over stages[{i}]'s "
+                      f"{len(counts)} configs as {list(counts)} leaves {', '.join(unrun)} without environments: they "
+                      "do not train; raise --num-envs", file=sys.stderr)
 
 
 def record(bench: Bench) -> Bench:
