@@ -76,7 +76,7 @@ def test_a_pack_of_two_mixture_runs_equals_them_alone(tmp_path):
 
 
 @pytest.mark.parametrize("stop_after", [2, 3])
-def test_a_resume_is_exact_across_a_stage_boundary(tmp_path, stop_after):
+def test_a_resume_is_exact_across_a_stage_boundary(tmp_path, capsys, stop_after):
     """Stage 2 starts at iteration 3 of 4: stopped after iteration 2 the resume enters it; stopped after 3 the
     resume loads environments of stage 2 from the checkpoint. Either way the run ends as one never stopped."""
     schedule = write_schedule(tmp_path / "curriculum.yaml", [(1, [NEAR_GOAL], None), (3, [NEAR_GOAL, RED], [1, 3])])
@@ -84,6 +84,7 @@ def test_a_resume_is_exact_across_a_stage_boundary(tmp_path, stop_after):
     whole = train.Args(**dict(FLAGS, run_eval_every=1), train_schedule=schedule, eval_config_path=RED, seed=11,
                        out=str(tmp_path / "whole"))
     train.train([whole])
+    assert f"kage.ppo.train: {whole.out}: iteration 3: stage 2 of 2 starts (train, train.1)" in capsys.readouterr().err
     stopped = dataclasses.replace(whole, out=str(tmp_path / "stopped"))
     train.train([stopped], stop_after=stop_after)
     assert checkpoint.load(f"{stopped.out}/checkpoints/latest.pt")["iteration"] == stop_after

@@ -174,6 +174,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         for k, run in enumerate(runs):  # a schedule's stage boundary: the run's batches for the new mixture
             stage = schedule.stage_at(run.stages, iteration)
             if stage != run.stage:
+                names = ", ".join(run.labels.get(c, c) for c in run.stages[stage].configs)
+                print(f"kage.ppo.train: {run.args.out}: iteration {iteration}: stage {stage + 1} of "
+                      f"{len(run.stages)} starts ({names})", file=sys.stderr, flush=True)
                 enter_stage(run, stage, threads, reset=True)
                 views.bind(k, run.env)
                 state.next_done[k] = 1.0  # the episodes under way end here
