@@ -131,3 +131,14 @@ def test_a_pair_named_outside_the_benchmark_directory_is_refused(tmp_path, name)
         run.main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *TINY_TRAINING])
     assert not (tmp_path / "bench").exists()
     assert not (tmp_path / "escaped").exists() and not os.path.exists("/tmp/escaped/seed_1")
+
+
+def test_a_misspelt_plug_in_of_gpu_runs_is_refused_without_a_gpu_here(tmp_path):
+    # GPU runs' plug-ins are imported and named by the runner, not called (no CUDA context in the runner).
+    suite = write_suite(tmp_path)
+    flags = [f for f in TINY_TRAINING if f not in ("--device", "cpu")]
+    with pytest.raises(SystemExit) as caught:
+        run.main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *flags, "--device", "cuda",
+                  "--augment", "kage.ppo.augment:colour_jitter", "--dry-run"])
+    assert "did you mean 'color_jitter'" in caught.value.code
+    assert not (tmp_path / "bench").exists()

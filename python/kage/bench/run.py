@@ -369,7 +369,9 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
 def check_before_runs(probe, units) -> None:
     """What every run's trainer would refuse at its start, refused once here before any run starts (else each run
     fails alike, and DIR keeps the flags that failed): a schedule stage after the runs' last iteration, and the
-    plug-ins (--agent built, --augment called once on blank frames) on the CPU at the first config's shape."""
+    plug-ins: imported and named, and for CPU runs also called as the trainer calls them (--agent built,
+    --augment on blank frames at the first config's shape). GPU runs' plug-ins are not called here: the runner
+    would hold a CUDA context beside its runs for the whole benchmark, or lack the GPU (a cluster's login node)."""
     for unit in units:
         starts = [stage["start"] for stage in unit.training.get("stages", [])]
         late = [i for i, start in enumerate(starts) if start > probe.num_iterations]
@@ -379,17 +381,19 @@ def check_before_runs(probe, units) -> None:
                              "--total-timesteps, or start the stage earlier")
     if probe.agent == plugins.BASELINE_AGENT and not probe.augment:
         return
-    import torch
-    with kage.make_vec(units[0].train_configs[0], 1, threads=1) as env:
-        height, width, channels = env.single_observation_space.shape
-        num_actions = int(env.single_action_space.n)
-    shape = (height, width, channels * (4 if probe.use_frame_stack else 1))
-    cpu = torch.device("cpu")
     try:
-        plugins.build_agent(probe.agent, shape, num_actions, [0], cpu, None)
         augment = plugins.load_augment(probe.augment)
-        if augment:
-            plugins.check_augment(augment, probe.augment, (1, 2, *shape), cpu)
+        plugins.load(probe.agent, "--agent")
+        if probe.device == "cpu":
+            import torch
+            with kage.make_vec(units[0].train_configs[0], 1, threads=1) as env:
+                height, width, channels = env.single_observation_space.shape
+                num_actions = int(env.single_action_space.n)
+            shape = (height, width, channels * (4 if probe.use_frame_stack else 1))
+            cpu = torch.device("cpu")
+            plugins.build_agent(probe.agent, shape, num_actions, [0], cpu, None)
+            if augment:
+                plugins.check_augment(augment, probe.augment, (1, 2, *shape), cpu)
     except SystemExit as e:
         trainer = "kage.ppo.train: "  # the plug-ins' refusals name the trainer
         text = e.code[len(trainer):] if isinstance(e.code, str) and e.code.startswith(trainer) else e.code
