@@ -5,10 +5,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <map>
 
 #include "compiler/basic/spell.h"
 #include "compiler/parse/compose.h"
+
+namespace fs = std::filesystem;
 
 namespace kage {
 
@@ -413,6 +416,25 @@ class SuiteLoader {
     }
   }
 
+  /// A training config of positive weight that is the eval config's file: the pair holds nothing out (a
+  /// leave-one-out mixture that leaves nothing out, say).
+  void warn_eval_in_training(const TrainMixture& mixture, const ConfigRef& eval) {
+    if (eval.inline_doc) return;
+    std::error_code ec;
+    const fs::path eval_path = fs::weakly_canonical(eval.path, ec);
+    if (ec) return;
+    for (const TrainStage& stage : mixture.stages)
+      for (const WeightedConfig& c : stage.configs) {
+        std::error_code same_ec;
+        if (c.weight > 0 && fs::weakly_canonical(c.path, same_ec) == eval_path && !same_ec) {
+          diags_.report(Rule::SuiteEvalInTraining, c.range,
+                        "the eval config '" + eval.path + "' is also a training config here: the pair does not hold "
+                        "its eval look out; drop it from the training (or give it weight 0) for a held-out pair");
+          return;
+        }
+      }
+  }
+
   void add_pair(Suite& suite, const DocNode& item) {
     check_keys(item, {"name", "description", "axis", "train", "eval", "allow"}, "a pair");
     SuitePair p;
@@ -423,6 +445,7 @@ class SuiteLoader {
     auto eval = config_of(item, "eval", suite);
     p.allow = allow_of(item);
     if (!axis || !train || !eval) return;
+    if (p.mixture) warn_eval_in_training(*p.mixture, *eval);
     p.axis = *axis;
     p.eval = std::move(*eval);
     suite.pairs.push_back(std::move(p));
@@ -450,6 +473,7 @@ class SuiteLoader {
       p.range = ev.range;
       auto config = config_of(ev, "config", suite);
       if (!axis || !train || !config) return;
+      if (mixture) warn_eval_in_training(*mixture, *config);
       p.axis = *axis;
       p.train = train_ref;
       p.mixture = mixture;
