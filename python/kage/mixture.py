@@ -62,15 +62,20 @@ def split(num_envs: int, weights: Sequence[Fraction]) -> Tuple[int, ...]:
     return tuple(counts)
 
 
+def unrun(counts: Sequence[int], weights: Sequence[Fraction]) -> List[int]:
+    """The configs of positive weight that a split gave no environment: they would not run at all, which a batch
+    too small for its weights does without failing."""
+    return [k for k, (n, w) in enumerate(zip(counts, weights)) if n == 0 and w > 0]
+
+
 def split_warned(num_envs: int, weights: Sequence[Fraction], configs: Sequence[str], caller: str) -> Tuple[int, ...]:
-    """split(), warning (UserWarning, at the caller's caller) when a config of positive weight gets no environment:
-    it would not run at all, which a batch too small for its weights does without failing."""
+    """split(), warning (UserWarning, at the caller's caller) of the configs it leaves unrun."""
     counts = split(num_envs, weights)
-    unrun = [k for k, (n, w) in enumerate(zip(counts, weights)) if n == 0 and w > 0]
-    if unrun:
-        names = ", ".join(f"configs[{k}] {configs[k]!r} (weight {float(weights[k]):g})" for k in unrun)
+    unrun_configs = unrun(counts, weights)
+    if unrun_configs:
+        names = ", ".join(f"configs[{k}] {configs[k]!r} (weight {float(weights[k]):g})" for k in unrun_configs)
         warnings.warn(f"{caller}: {num_envs} environments split as {list(counts)} leave {names} none, so "
-                      f"{'it runs' if len(unrun) == 1 else 'they run'} nowhere; give more environments or a larger "
+                      f"{'it runs' if len(unrun_configs) == 1 else 'they run'} nowhere; give more environments or a larger "
                       "weight (kage.mixture gives the rule)", UserWarning, stacklevel=3)
     return counts
 

@@ -331,10 +331,10 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
     starts."""
     if args.pack < 1:
         raise SystemExit(f"kage.bench: --pack {args.pack}: a positive number of runs per process")
-    for flag in PER_RUN_FLAGS:
-        if any(arg == flag or arg.startswith(flag + "=") for arg in trainer_args):
-            raise SystemExit(f"kage.bench: {flag} is set per run by kage.bench; remove it")
     from kage.ppo import args as trainer, train
+    for flag in PER_RUN_FLAGS:
+        if trainer.times_given(trainer_args, flag):
+            raise SystemExit(f"kage.bench: {flag} is set per run by kage.bench; remove it")
     try:
         probe = train.parse_args(["--train-config-path", args.suite, *trainer_args])  # trainer flags checked now
     except SystemExit as e:
@@ -372,13 +372,14 @@ def check_before_runs(probe, units) -> None:
     plug-ins: imported and named, and for CPU runs also called as the trainer calls them (--agent built,
     --augment on blank frames at the first config's shape). GPU runs' plug-ins are not called here: the runner
     would hold a CUDA context beside its runs for the whole benchmark, or lack the GPU (a cluster's login node)."""
+    from kage.ppo import schedule
     for unit in units:
-        starts = [stage["start"] for stage in unit.training.get("stages", [])]
-        late = [i for i, start in enumerate(starts) if start > probe.num_iterations]
-        if late:
-            raise SystemExit(f"kage.bench: {unit.name} trains on {unit.train}, whose stages[{late[0]}] starts at "
-                             f"iteration {starts[late[0]]}, after the runs' last ({probe.num_iterations}): raise "
-                             "--total-timesteps, or start the stage earlier")
+        stages = [schedule.Stage(s["start"], tuple(c["name"] for c in s["configs"]))
+                  for s in unit.training.get("stages", [])]
+        try:
+            schedule.check_iterations(stages, probe.num_iterations, f"{unit.name} (trains on {unit.train})")
+        except schedule.ScheduleError as e:
+            raise SystemExit(f"kage.bench: {e}") from None
     if probe.agent == plugins.BASELINE_AGENT and not probe.augment:
         return
     try:
@@ -409,7 +410,7 @@ def warn_unrun_configs(num_envs: int, units) -> None:
         for i, stage in enumerate(unit.training.get("stages", [])):
             weights = [Fraction(c["weight"]) for c in stage["configs"]]
             counts = mixture.split(num_envs, weights)
-            unrun = [c["name"] for c, n, w in zip(stage["configs"], counts, weights) if n == 0 and w > 0]
+            unrun = [stage["configs"][k]["name"] for k in mixture.unrun(counts, weights)]
             if unrun:
                 print(f"kage.bench: warning: {unit.name}: --num-envs {num_envs} split over stages[{i}]'s "
                       f"{len(counts)} configs as {list(counts)} leaves {', '.join(unrun)} without environments: they "
