@@ -20,6 +20,7 @@ import sys
 from typing import List
 
 from kage.bench import run, tasks
+from kage.ppo.args import times_given
 from kage.util.files import atomic_write, os_error_text
 from kage.util.text import plural
 
@@ -123,7 +124,7 @@ def main(argv: List[str]) -> int:
     parser.add_argument("--submit", action="store_true", help="submit the script with sbatch and print the job id")
     args, trainer_args = parser.parse_known_args(argv)
     for flag in ("--task", "--gpus"):
-        if any(a == flag or a.startswith(flag + "=") for a in trainer_args):
+        if times_given(trainer_args, flag):
             raise SystemExit(f"kage.bench slurm: {flag} is for kage.bench run; each array task is one task")
     for name in ("gpus_per_task", "array_parallelism"):
         value = getattr(args, name)

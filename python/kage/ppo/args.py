@@ -122,6 +122,11 @@ class Args:
 PROG = "python3 -m kage.ppo.train"  # the trainer's command, which its refusals start with
 
 
+def times_given(argv: List[str], flag: str) -> int:
+    """How many times `flag` is in `argv`, as `--flag VALUE` or `--flag=VALUE`."""
+    return sum(a == flag or a.startswith(flag + "=") for a in argv)
+
+
 def unknown_argument(parser: argparse.ArgumentParser, word: str) -> str:
     """What is wrong with `word`, the first argument `parser` did not take, and the fix."""
     if not word.startswith("-"):
@@ -157,7 +162,7 @@ def parse_args(argv: Optional[List[str]] = None) -> Args:
     parser.add_argument("--pack", help="train the runs listed in this JSON file together (written by kage.bench)")
     given = sys.argv[1:] if argv is None else argv
     for flag, one in ONE_EACH.items():  # argparse keeps the last silently, where a user may expect them combined
-        times = sum(a == flag or a.startswith(flag + "=") for a in given)
+        times = times_given(given, flag)
         if times > 1:
             parser.error(f"{flag} given {times} times: {one}")
     known, extras = parser.parse_known_args(argv)
