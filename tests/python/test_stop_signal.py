@@ -33,20 +33,27 @@ def train_rows(run_dir):
     return sum(1 for line in open(run_dir / "metrics.jsonl") if '"kind": "train"' in line)
 
 
+def stopped_run(out, signum, after_rows):
+    """kage.bench run into `out`, sent `signum` once its run has logged `after_rows` training rows: (the runner's
+    exit code, its output, the run's directory)."""
+    run_dir = out / "runs" / "background" / "1" / "seed_1"
+    child = bench_run(out)
+    deadline = time.time() + 600
+    while time.time() < deadline and child.poll() is None and train_rows(run_dir) < after_rows:
+        time.sleep(0.05)
+    assert child.poll() is None, "the run ended before it could be stopped"
+    child.send_signal(signum)
+    output = child.communicate(timeout=300)[0]
+    return child.returncode, output, run_dir
+
+
 def test_sigterm_checkpoints_and_resumes(tmp_path):
     whole, stopped = tmp_path / "whole", tmp_path / "stopped"
     first = bench_run(whole)
     assert first.wait(timeout=900) == 0, first.stdout.read()
 
-    run_dir = stopped / "runs" / "background" / "1" / "seed_1"
-    child = bench_run(stopped)
-    deadline = time.time() + 600
-    while time.time() < deadline and child.poll() is None and train_rows(run_dir) < 2:
-        time.sleep(0.05)
-    assert child.poll() is None, "the run ended before it could be stopped"
-    child.send_signal(signal.SIGTERM)
-    output = child.communicate(timeout=300)[0]
-    assert child.returncode == 128 + signal.SIGTERM, output
+    code, output, run_dir = stopped_run(stopped, signal.SIGTERM, 2)
+    assert code == 128 + signal.SIGTERM, output
     assert "kage.bench run: stopped background/1 seed 1; run again (or requeue) to resume" in output
     log = (run_dir / "train.log").read_text()
     assert "kage.ppo.train: stopped after iteration" in log
@@ -62,13 +69,6 @@ def test_sigterm_checkpoints_and_resumes(tmp_path):
 
 
 def test_ctrl_c_stops_the_runner_with_the_shells_code_for_sigint(tmp_path):
-    run_dir = tmp_path / "runs" / "background" / "1" / "seed_1"
-    child = bench_run(tmp_path)
-    deadline = time.time() + 600
-    while time.time() < deadline and child.poll() is None and train_rows(run_dir) < 1:
-        time.sleep(0.05)
-    assert child.poll() is None, "the run ended before it could be stopped"
-    child.send_signal(signal.SIGINT)
-    output = child.communicate(timeout=300)[0]
-    assert child.returncode == 128 + signal.SIGINT, output  # 130, as the trainer's own Ctrl-C
+    code, output, _ = stopped_run(tmp_path, signal.SIGINT, 1)
+    assert code == 128 + signal.SIGINT, output  # 130, as the trainer's own Ctrl-C
     assert "kage.bench run: stopped background/1 seed 1; run again (or requeue) to resume" in output
