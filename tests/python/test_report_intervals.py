@@ -158,12 +158,19 @@ def test_metric_progress(tmp_path):
         write_run(tmp_path, "background/1", seed, ["eval"],
                   plain(0.0, 0.0, **{"train/progress": train, "eval/eval/progress": evaluated}),
                   rows=rows_for([(0.0, 0.0)]))
+    success = report.report(str(tmp_path), reps=500)
     result = report.report(str(tmp_path), reps=500, metric="progress")
     row = by_name(result["intervals"]["rows"], "name", "background")
     # three values each: nothing cut, so the IQMs are the means 0.7 and 0.3
     assert row["train_iqm"]["point"] == pytest.approx(0.7) and row["eval_iqm"]["point"] == pytest.approx(0.3)
     assert row["drop_pct"]["point"] == pytest.approx(100 * 0.4 / 0.7)
-    assert "## Interval estimates of `progress`" in (tmp_path / "report" / "intervals.md").read_text()
-    assert (tmp_path / "report" / "plots" / "profile_progress.png").read_bytes().startswith(PNG_SIGNATURE)
+    # Its own folder: the success report beside it stays as it was.
+    assert result["out_dir"] == str(tmp_path / "report_progress") and success["out_dir"] == str(tmp_path / "report")
+    assert "## Interval estimates of `progress`" in (tmp_path / "report_progress" / "intervals.md").read_text()
+    assert "## Interval estimates of `success_once`" in (tmp_path / "report" / "intervals.md").read_text()
+    assert (tmp_path / "report_progress" / "plots" / "profile_progress.png").read_bytes().startswith(PNG_SIGNATURE)
+    assert not (tmp_path / "report" / "plots" / "profile_progress.png").exists()
+    final = report.report(str(tmp_path), protocol="final", reps=100, metric="progress", partial=True)
+    assert final["out_dir"] == str(tmp_path / "report_final_progress_interim")
     with pytest.raises(SystemExit, match="take success_once, success, progress, not 'passed_distance'"):
         report.report(str(tmp_path), reps=100, metric="passed_distance")

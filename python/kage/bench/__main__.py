@@ -22,7 +22,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     status.add_argument("dir", help="a directory written by `python3 -m kage.bench run` or `slurm`")
     report = commands.add_parser("report", help="write the tables and plots of a benchmark directory")
     report.add_argument("dir", help="a directory written by `python3 -m kage.bench run`")
-    report.add_argument("--out", help="where to write (default DIR/report, DIR/report_final with --protocol final)")
+    report.add_argument("--out", help="where to write (default DIR/report, DIR/report_final with --protocol final; "
+                                      "the metric's name appended for another --metric: DIR/report_progress)")
     report.add_argument("--protocol", choices=("max", "final"), default="max",
                         help="a run's value: its maximum over training (the paper's) or its last evaluation")
     report.add_argument("--reps", type=int, default=50000, help="bootstrap resamples of the interval estimates")

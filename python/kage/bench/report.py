@@ -56,7 +56,8 @@ Output, in DIR/report/ (or out_dir), each file replaced atomically:
     report.json              everything above, the runs found and the protocol
     plots/*.png              see kage.bench.plots
 
-With `protocol` "final" the default directory is DIR/report_final/.
+With `protocol` "final" the default directory is DIR/report_final/; with an interval `metric` other than
+success_once, its name is appended (DIR/report_progress/), so that no report of another metric is replaced.
 """
 import json
 import math
@@ -536,10 +537,18 @@ def read_benchmark(bench_dir: str) -> Tuple[dict, dict, List[Unit], Dict[str, Li
     return suite, bench, units, {unit.name: find_runs(bench_dir, unit) for unit in units}
 
 
+def default_out_dir(bench_dir: str, protocol: str, partial: bool, metric: str) -> str:
+    """DIR/report[_final][_METRIC][_interim]: one folder per protocol, interval metric and interim-ness, so that
+    a report never replaces one of another kind."""
+    return os.path.join(bench_dir, "report" + ("_final" if protocol == "final" else "")
+                        + ("" if metric == SUCCESS_SHOWN else "_" + metric) + ("_interim" if partial else ""))
+
+
 def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
            reps: int = intervals.REPS, partial: bool = False, metric: str = SUCCESS_SHOWN) -> dict:
     """Reads the benchmark directory `bench_dir`, writes the tables, plots and report.json into `out_dir`
-    (default bench_dir/report, report_final under `protocol` "final", with "_interim" appended under `partial`)
+    (default_out_dir: bench_dir/report, report_final under `protocol` "final", the metric's name appended
+    when it is not success_once, "_interim" under `partial`)
     and returns report.json's content. `reps`: bootstrap resamples of the interval estimates of `metric`."""
     if protocol not in PROTOCOLS:
         fail(f"unknown protocol '{protocol}': choose {' or '.join(PROTOCOLS)}")
@@ -548,8 +557,7 @@ def report(bench_dir: str, out_dir: Optional[str] = None, protocol: str = "max",
     if intervals.reps_problem(reps):
         fail(intervals.reps_problem(reps))
     suite, bench, units, runs = read_benchmark(bench_dir)
-    out_dir = out_dir or os.path.join(bench_dir, ("report" if protocol == "max" else "report_final")
-                                      + ("_interim" if partial else ""))
+    out_dir = out_dir or default_out_dir(bench_dir, protocol, partial, metric)
     levels = aggregate(units, runs, protocol, partial)
     status = run_status(units, runs, [s for s in bench.get("seeds", []) if isinstance(s, int)], partial)
     result = {
