@@ -1,5 +1,7 @@
 """Plug-ins that break the contract (kage.ppo.plugins), each refused before the trainer writes anything
-(tests/python/test_checks_before_writing.py)."""
+(tests/python/test_checks_before_writing.py), or, drawing from a global random generator, warned of
+(tests/python/test_plugins.py)."""
+import numpy as np
 import torch
 import torch.nn as nn
 
@@ -47,3 +49,12 @@ def integer_logits(observation_shape, num_actions, seeds, device):
         def forward(self, obs):
             return torch.zeros((obs.shape[0], num_actions), dtype=torch.long), torch.zeros(obs.shape[0], dtype=torch.long)
     return Net()
+
+
+def global_torch_noise(obs, uniform):
+    """Draws from torch's global generator, not `uniform`: accepted, with a warning that it will not reproduce."""
+    return (obs.float() + torch.rand(obs.shape) * 8).clamp(0, 255).to(torch.uint8)
+
+
+def global_numpy_flip(obs, uniform):
+    return obs.flip(-2) if np.random.rand() < 0.5 else obs

@@ -105,3 +105,11 @@ def test_a_misspelt_shipped_config_is_named_with_the_nearest_names(tmp_path):
                               "a shipped config name"), message
     assert "near names: kage_bench/background/1-eval" in message
     assert not out.exists()
+
+
+def test_an_augmentation_drawing_from_a_global_generator_trains_with_a_warning(tmp_path, capsys):
+    out = tmp_path / "run"
+    train.main(BASE + ["--device", "cpu", "--out", str(out), "--augment", "bad_plugins:global_torch_noise"])
+    assert "kage.ppo.train: warning: --augment bad_plugins:global_torch_noise draws from torch's global random " \
+           "generator" in capsys.readouterr().err
+    assert (out / "summary.json").exists()

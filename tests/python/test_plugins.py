@@ -30,6 +30,21 @@ def test_references_are_checked_with_their_fix():
         plugins.load_augment("math:sqrt")
 
 
+@pytest.mark.parametrize("reference, generators", [
+    ("bad_plugins:global_torch_noise", "torch's global"), ("bad_plugins:global_numpy_flip", "numpy's global")])
+def test_an_augmentation_drawing_from_a_global_generator_is_warned_of(reference, generators):
+    warning = plugins.check_augment(plugins.load_augment(reference), reference, (2, 2, *SHAPE), "cpu")
+    assert warning.startswith(f"--augment {reference} draws from {generators} random generator")
+    assert "will not reproduce when resumed" in warning and "`uniform(shape)`" in warning
+
+
+def test_the_shipped_augmentations_draw_from_their_own_streams():
+    import kage.ppo.augment as shipped
+    for name in shipped.__all__:
+        reference = f"kage.ppo.augment:{name}"
+        assert plugins.check_augment(plugins.load_augment(reference), reference, (2, 2, 44, 44, 3), "cpu") is None
+
+
 def test_agents_are_built_in_the_pack_interface():
     packed = plugins.build_agent("kage.ppo.agent:nature_cnn", (44, 44, 3), 5, [1, 2], "cpu")
     logits, value = packed(torch.zeros((2, 7, 44, 44, 3), dtype=torch.uint8))

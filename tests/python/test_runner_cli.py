@@ -143,3 +143,12 @@ def test_a_misspelt_plug_in_of_gpu_runs_is_refused_without_a_gpu_here(tmp_path):
                   "--augment", "kage.ppo.augment:colour_jitter", "--dry-run"])
     assert "did you mean 'color_jitter'" in caught.value.code
     assert not (tmp_path / "bench").exists()
+
+
+def test_a_plug_in_drawing_from_a_global_generator_is_warned_of_before_any_run(tmp_path, capsys):
+    suite = write_suite(tmp_path)
+    run.main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *TINY_TRAINING,
+              "--augment", "bad_plugins:global_numpy_flip"])
+    err = capsys.readouterr().err
+    warning = "kage.bench: warning: --augment bad_plugins:global_numpy_flip draws from numpy's global random generator"
+    assert warning in err and err.index(warning) < err.index("[1/")  # before the first run starts

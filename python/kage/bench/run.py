@@ -394,7 +394,9 @@ def check_before_runs(probe, units) -> None:
             cpu = torch.device("cpu")
             plugins.build_agent(probe.agent, shape, num_actions, [0], cpu, None)
             if augment:
-                plugins.check_augment(augment, probe.augment, (1, 2, *shape), cpu)
+                warning = plugins.check_augment(augment, probe.augment, (1, 2, *shape), cpu)
+                if warning:
+                    print(f"kage.bench: warning: {warning}", file=sys.stderr, flush=True)
     except SystemExit as e:
         trainer = "kage.ppo.train: "  # the plug-ins' refusals name the trainer
         text = e.code[len(trainer):] if isinstance(e.code, str) and e.code.startswith(trainer) else e.code

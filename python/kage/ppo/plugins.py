@@ -17,7 +17,8 @@ An augmentation is called as fn(obs, uniform) on training frames, as --augment-m
 the update's minibatches (drac, update) or the rollout's observations (rollout), never an evaluation's.
 obs is uint8 [K, B, H, W, C], uniform(shape) returns [K, *shape] float32 uniforms in (0, 1) from each run's own
 counter-based stream (the same numbers alone, packed or resumed); it returns uint8 frames of the same shape on
-the same device (checked on blank frames before anything is written, and on every call). One that sets
+the same device (checked on blank frames before anything is written, and on every call; drawing from a global
+random generator instead of `uniform` is warned of there, as its runs would not reproduce). One that sets
 `fn.takes_frame_indices = True` (as kage.ppo.augment's) is called on update minibatches as fn(frames, uniform,
 images=images), run k's b-th frame being frames.reshape(-1, H, W, C)[images[k, b]], so it may read them where
 the rollout stored them.
@@ -25,8 +26,10 @@ the rollout stored them.
 import difflib
 import importlib
 import inspect
+import random as python_random  # `random` names a run's CounterRandom here
 from typing import Callable, List, Optional, Sequence
 
+import numpy as np
 import torch
 import torch.nn as nn
 
@@ -207,9 +210,31 @@ def augmented_problem(out, shape, device) -> Optional[str]:
     return None
 
 
-def check_augment(fn: Callable, reference: str, shape, device) -> None:
+def global_generators(device) -> dict:
+    """The states of the global random generators an augmentation could draw from instead of `uniform`."""
+    states = {"torch's": torch.get_rng_state(), "numpy's": np.random.get_state(), "Python's": python_random.getstate()}
+    if torch.device(device).type == "cuda":
+        states["torch.cuda's"] = torch.cuda.get_rng_state(device)
+    return states
+
+
+def same_state(a, b) -> bool:
+    if torch.is_tensor(a):
+        return torch.equal(a, b)
+    if isinstance(a, (tuple, list)):
+        return len(a) == len(b) and all(same_state(x, y) for x, y in zip(a, b))
+    if hasattr(a, "shape"):  # numpy's key array
+        return bool((a == b).all())
+    return a == b
+
+
+def check_augment(fn: Callable, reference: str, shape, device) -> Optional[str]:
     """Calls the augmentation once on blank uint8 frames of the real shape (K runs of 2 frames), alone and, where it
-    reads frames at indices, at indices, so that a wrong output is refused before anything is written."""
+    reads frames at indices, at indices, so that a wrong output is refused before anything is written. Returns a
+    warning when the calls drew from a global random generator (torch's, numpy's, Python's): such draws are the
+    process's, not the run's, so a resumed or packed run draws other numbers than the same run uninterrupted or
+    alone."""
+    before = global_generators(device)
     random = CounterRandom([0] * shape[0], device)
     counter = torch.zeros((), dtype=torch.int64, device=device)
     blank = torch.zeros(shape, dtype=torch.uint8, device=device)
@@ -222,3 +247,10 @@ def check_augment(fn: Callable, reference: str, shape, device) -> None:
         except Exception as e:  # a user's function: whatever it raises is reported as its failure
             raise SystemExit(f"kage.ppo.train: --augment {reference}: on blank uint8 frames {list(shape)} it raised "
                              f"{type(e).__name__}: {e}") from None
+    after = global_generators(device)
+    drawn = [name for name in before if not same_state(before[name], after[name])]
+    if not drawn:
+        return None
+    return (f"--augment {reference} draws from {' and '.join(drawn)} global random generator: those numbers are the "
+            "process's, not the run's, so the run will not reproduce when resumed, packed with others or run alone; "
+            "draw from its `uniform(shape)` argument instead (each run's own stream, kage.ppo.plugins)")

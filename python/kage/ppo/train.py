@@ -110,7 +110,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                                 speed_modes(args))  # §2.4: the runs' seeds
     augment = plugins.load_augment(args.augment)
     if augment:
-        plugins.check_augment(augment, args.augment, (K, 2, height, width, channels), device)
+        warning = plugins.check_augment(augment, args.augment, (K, 2, height, width, channels), device)
+        if warning:
+            print(f"kage.ppo.train: warning: {warning}", file=sys.stderr, flush=True)
     check_memory(args, K, (height, width, channels), device)
     # A network that reads a minibatch where the rollout stored it (kage.ppo.agent.Agent) gets the buffer and
     # the frames' indices; any other gets the gathered frames.
