@@ -4,7 +4,9 @@
 # FLAGS (defaults: kage_bench, 1-10, every pair), trains in DIR on the machine's disk:
 # - GPUS=all (a machine of several GPUs): every task, one worker per GPU (`--gpus all`), or with TASKS=0,3 only
 #   those tasks (`--tasks`: what fits a lease, the others left for the next);
-# - TASK=I: task I alone, on one GPU.
+# - TASK=I: task I alone, on one GPU. Two runners side by side on one GPU train no faster together than one after
+#   the other (lab/2026-11-29-h200-drac-two-tasks), and a task must finish inside the lease (its checkpoints, 58 MB a
+#   run, cannot travel to the next): on one GPU, start the tasks that fit, one at a time.
 # The runner runs in a process session of its own (setsid), which the device machine leaves running when a
 # call returns, so it trains on through the lease's calls and the gaps between them, never stopped and resumed.
 # It runs from a copy of the tree made by the lease's first call (ROOT), since every call copies the working
@@ -113,5 +115,9 @@ bring_so_far() {
 }
 bring_so_far
 runner_alive && echo "table_device: the runner trains on ($(date -u +%H:%M:%S) UTC); call again" >>"$OUT/call.log"
+# Each unfinished pack's last trainer line (iteration, rate, ETA): whether what is left fits the lease.
+for log in "$DIR"/packs/task_*_pack_*.log; do
+  [ -e "$log" ] && ! grep -q '^kage.ppo.train: done' "$log" && printf '%s: %s\n' "${log##*/}" "$(tail -n1 "$log")"
+done >>"$OUT/call.log"
 python3 -m kage.bench status "$DIR" >>"$OUT/call.log" 2>&1
 tail -40 "$OUT/call.log"
