@@ -9,6 +9,11 @@ first observation of the episode the runtime already started in that step (its r
 environment's own seed stream, as in ``kage.make_vec``); ``reset(seed=s)`` starts afresh from ``s``.
 Stepping on after an episode's end without ``reset()`` continues that new episode (Gymnasium's
 PassiveEnvChecker warns about it).
+
+Seeds as Gymnasium's: ``reset()`` anywhere else (the first reset, or in the middle of an episode, as a
+``TimeLimit`` wrapper's truncation leaves it) starts a new episode from a seed drawn from ``self.np_random``,
+which Gymnasium seeds from the operating system's entropy until a ``reset(seed=s)`` seeds it from ``s``: unseeded
+environments differ from one another, and a seeded one repeats its episodes.
 """
 from typing import Any, Dict, Optional, Tuple
 
@@ -33,24 +38,27 @@ class SingleEnv(gymnasium.Env):
         self.observation_space = self._batch.single_observation_space
         self.action_space = self._batch.single_action_space
         self._frame: Optional[np.ndarray] = None
+        self._episode_ended = False  # the last step ended an episode: the runtime has started the next one
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None
               ) -> Tuple[np.ndarray, Dict[str, Any]]:
         super().reset(seed=seed)
         if options:
             raise ValueError(f"reset: unknown options {sorted(options)} (a single environment takes none)")
-        if seed is not None or self._frame is None:
-            obs, info = self._batch.reset(seed=seed)
-            return self._keep(obs[0]), _row(info)
-        # The runtime started the next episode in the step that ended the last one: return its start.
-        obs, _, _, _, info = self._batch.outputs()
+        if seed is None and self._episode_ended:
+            # The runtime started the next episode in the step that ended the last one: return its start.
+            obs, _, _, _, info = self._batch.outputs()
+        else:
+            obs, info = self._batch.reset(seed=seed if seed is not None else int(self.np_random.integers(2**63)))
+        self._episode_ended = False
         return self._keep(obs[0]), _row(info)
 
     def step(self, action) -> Tuple[np.ndarray, float, bool, bool, Dict[str, Any]]:
         if not self.action_space.contains(action):
             raise ValueError(f"action {action!r}: an integer in 0..{self.action_space.n - 1}")
         obs, reward, terminated, truncated, info = self._batch.step(np.array([action], dtype=np.int32))
-        if bool(np.asarray(info["_final"])[0]):  # the episode ended: show its end, not the next start
+        self._episode_ended = bool(np.asarray(info["_final"])[0])
+        if self._episode_ended:  # show the episode's end, not the next start
             obs, fields = info["final_obs"], info["final_info"]
         else:
             fields = info

@@ -84,6 +84,48 @@ def test_the_single_environment_ends_an_episode_as_gymnasium_says():
         env.close()
 
 
+def test_a_reset_in_the_middle_of_an_episode_starts_a_new_one():
+    """A TimeLimit wrapper truncates where the runtime's episode goes on: reset() used to return that episode's
+    current state (timestep 100), and Gymnasium's sync vector environment carried every episode on."""
+    env = gymnasium.make("kage/KAGE-v0", config=SIMPLEST, max_episode_steps=100, disable_env_checker=True)
+    try:
+        env.reset(seed=0)
+        for _ in range(100):
+            *_, truncated, info = env.step(2)
+        assert truncated and info["timestep"] == 100
+        obs, info = env.reset()
+        assert info["timestep"] == 0 and info["return"] == 0 and info["passed_distance"] == 0
+    finally:
+        env.close()
+    vector = gymnasium.make_vec("kage/KAGE-v0", num_envs=2, vectorization_mode="sync", config=SIMPLEST,
+                                max_episode_steps=10)
+    try:
+        vector.reset(seed=1)
+        timesteps = [vector.step(np.array([2, 2]))[4]["timestep"].tolist() for _ in range(12)]
+        assert timesteps[9] == [10, 10] and timesteps[10] == [0, 0] and timesteps[11] == [1, 1]
+    finally:
+        vector.close()
+
+
+def test_unseeded_single_environments_differ_and_seeded_ones_repeat():
+    config = str(kage.resources.config_path("kage_bench/distractors/5-eval"))
+    envs = [gymnasium.make("kage/KAGE-v0", config=config, disable_env_checker=True) for _ in range(3)]
+    try:
+        first = [env.reset()[0] for env in envs]
+        assert not np.array_equal(first[0], first[1]) and not np.array_equal(first[1], first[2])
+        # Seeded, reset() draws from the env's np_random, which reset(seed=s) seeded: the same episodes again.
+        episodes = []
+        for env in envs[:2]:
+            env.reset(seed=7)
+            for _ in range(5):
+                env.step(3)
+            episodes.append(env.reset()[0])
+        assert np.array_equal(episodes[0], episodes[1])
+    finally:
+        for env in envs:
+            env.close()
+
+
 def test_a_make_without_config_or_with_a_bad_one_names_the_fix():
     """It raised Python's "missing 1 required positional argument: 'config'", "expected str, bytes or
     os.PathLike object, not int", or make_vec's "unexpected keyword argument 'render_mode'"."""
