@@ -48,13 +48,31 @@ class Args:
     adam_eps: float = 1e-5
 
 
+def boolean(text: str) -> bool:
+    """A flag's true or false, as written; anything else (a misspelt `flase`) refused, not read as false."""
+    if text.lower() in ("1", "true", "yes"):
+        return True
+    if text.lower() in ("0", "false", "no"):
+        return False
+    raise argparse.ArgumentTypeError(f"{text!r}: true or false")
+
+
 def parse_args() -> Args:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     for f in dataclasses.fields(Args):
-        kind = (lambda s: s.lower() in ("1", "true", "yes")) if f.type is bool else f.type
-        parser.add_argument("--" + f.name.replace("_", "-"), type=kind, default=f.default)
+        parser.add_argument("--" + f.name.replace("_", "-"), type=boolean if f.type is bool else f.type,
+                            default=f.default)
     args = Args(**vars(parser.parse_args()))
-    if args.total_timesteps < args.num_envs * args.num_steps:
+    for name in ("num_seeds", "total_timesteps", "num_envs", "num_steps", "num_minibatches", "update_epochs"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name.replace('_', '-')} {getattr(args, name)}: a positive number")
+    batch = args.num_envs * args.num_steps
+    if batch % args.num_minibatches:
+        divisors = [d for d in range(1, min(batch, 64) + 1) if batch % d == 0]
+        parser.error(f"--num-minibatches {args.num_minibatches} does not divide the batch (--num-envs * --num-steps "
+                     f"= {batch}) into equal minibatches: choose one of {', '.join(map(str, divisors))}, or change "
+                     "--num-envs or --num-steps")
+    if args.total_timesteps < batch:
         parser.error(f"--total-timesteps {args.total_timesteps} is less than one iteration (--num-envs * --num-steps "
                      f"= {args.num_envs * args.num_steps}): it would train nothing")
     return args

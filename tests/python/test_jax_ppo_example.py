@@ -69,6 +69,11 @@ def test_two_seeds_train_two_iterations():
 
 @pytest.mark.parametrize("flags, message", [
     (["--total-timesteps", "10"], "--total-timesteps 10 is less than one iteration"),
+    (["--num-envs", "8", "--num-steps", "32", "--num-minibatches", "3"],
+     "--num-minibatches 3 does not divide the batch (--num-envs * --num-steps = 256) into equal minibatches: choose "
+     "one of 1, 2, 4, 8, 16, 32, 64"),
+    (["--norm-adv", "flase"], "argument --norm-adv: 'flase': true or false"),
+    (["--num-envs", "0"], "--num-envs 0: a positive number"),
     (["--config", "nothere.yaml"], "jax_ppo.py: --config: config 'nothere.yaml' is neither a path nor a shipped"),
 ])
 def test_a_run_it_cannot_make_is_refused_in_one_line(flags, message):
