@@ -25,6 +25,7 @@ BASE = ["--train-config-path", NOISY_SKELETON, "--seed", "3", "--threads", "1", 
     ["--reward-clip-min", "1", "--reward-clip-max", "0"], ["--reward-clip-min", "nan"], ["--seed", "-1"],
     ["--seed", str(2**64)], ["--save-checkpoint-every", "-1"], ["--threads", "0"], ["--threads", "-2"],
     ["--num-envs", str(2**31)], ["--eval-num-envs", str(2**31)], ["--num-steps", str(2**40)],
+    ["--asset-root", "/nonexistent-asset-root"],
 ], ids=lambda flags: " ".join(flags))
 def test_nonsense_values_are_refused_before_anything_is_written(tmp_path, flags):
     out = tmp_path / "run"

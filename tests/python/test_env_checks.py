@@ -89,6 +89,17 @@ def test_arguments_the_binding_cannot_take_are_value_errors(kwargs, match):
         kage.make_vec(SIMPLEST, **kwargs)
 
 
+def test_an_asset_root_that_is_no_directory_is_named(tmp_path):
+    """It was taken as the base of the config's relative asset paths anyway: a config without assets ignored it,
+    one with assets reported its YAML's paths as missing, without naming asset_root."""
+    for root in (tmp_path / "nonexistent", tmp_path / "a_file"):
+        if root.name == "a_file":
+            root.write_text("")
+        with pytest.raises(FileNotFoundError, match=f"asset_root='{root}': no such directory; it replaces the "
+                                                    "config's own folder"):
+            kage.make_vec(SIMPLEST, 2, asset_root=root)
+
+
 def test_a_batch_larger_than_the_machine_is_refused_before_allocating():
     with pytest.raises(ValueError, match="more than half of this machine's") as e:
         kage.make_vec(SIMPLEST, 2**30, threads=1)

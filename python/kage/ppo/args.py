@@ -262,6 +262,8 @@ def range_problems(args: Args) -> List[str]:
     need(args.save_checkpoint_every >= 0, f"--save-checkpoint-every {args.save_checkpoint_every}: 0 (at the end "
          "only) or a positive number of iterations")
     need(args.threads is None or 0 < args.threads <= 4096, f"--threads {args.threads}: a positive number of threads")
+    need(args.asset_root is None or os.path.isdir(args.asset_root), f"--asset-root {args.asset_root}: no such "
+         "directory (it replaces each config's own folder as the base of its relative asset paths)")
     need(args.num_envs <= MAX_INT32 and args.eval_num_envs <= MAX_INT32 and args.num_steps <= MAX_INT32,
          f"--num-envs, --eval-num-envs and --num-steps: at most {MAX_INT32}")
     return problems
