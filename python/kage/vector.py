@@ -86,7 +86,7 @@ def _state_bytes(state) -> Any:
     return view if view.c_contiguous and view.ndim == 1 else view.tobytes()
 
 
-class VecEnv:
+class VecEnv(spaces.VectorEnvBase):
     """``num_envs`` environments of one configuration (or of a mixture: ``make_vec``), stepped together.
 
     ``reset(seed=None, options=None) -> (obs, info)`` and
@@ -103,9 +103,11 @@ class VecEnv:
     (a dict of the same fields), where the bool mask ``info["_final"]`` is true (so ``final_obs[info["_final"]]``
     selects the finished rows). Rows where ``_final`` is false hold an earlier episode's end, or zeros.
 
-    Gymnasium: ``metadata["autoreset_mode"]`` is ``gymnasium.vector.AutoresetMode.SAME_STEP`` where Gymnasium
-    is importable; ``gymnasium.make_vec("kage/KAGE-v0", ...)`` returns this class (``kage.registration``) and
-    sets ``spec`` to its ``EnvSpec``. The batch's resolved Spec is ``resolved_spec``.
+    Gymnasium: where it is importable, this is a ``gymnasium.vector.VectorEnv`` (its vector wrappers, such as
+    ``RecordEpisodeStatistics``, take it), ``metadata["autoreset_mode"]`` is ``AutoresetMode.SAME_STEP`` and
+    ``observation_space``/``action_space`` are the batched spaces; ``gymnasium.make_vec("kage/KAGE-v0", ...)``
+    returns this class (``kage.registration``) and sets ``spec`` to its ``EnvSpec``. The batch's resolved Spec
+    is ``resolved_spec``.
 
     Threads: a batch may be used from any thread, and calls from several threads run one at a time, each
     one whole (a step's state is never torn, ``save_state`` never sees half a step). ``close()`` (and
@@ -138,6 +140,8 @@ class VecEnv:
         self.spec_hash = handle.spec_hash
         self.single_observation_space = spaces.observation_space(handle.height, handle.width)
         self.single_action_space = spaces.action_space()
+        self.observation_space = spaces.batched(self.single_observation_space, self.num_envs)
+        self.action_space = spaces.batched(self.single_action_space, self.num_envs)
         self._seed = seed
         self._resets_without_seed = 0
         self._last_actions = None

@@ -1,6 +1,9 @@
 """kage with the real Gymnasium 1.x: the registered vector and single environments, Gymnasium's own spaces, its
-autoreset mode, its environment checker on the single environment, and bool flags and masks that index as
+vector wrappers, its autoreset mode, its environment checker on the single environment, and bool flags and masks that index as
 masks. Gymnasium's checks that do not apply are listed in README ("Gymnasium")."""
+import subprocess
+import sys
+
 import gymnasium
 import numpy as np
 import pytest
@@ -27,6 +30,38 @@ def test_make_vec_returns_the_project_vector_environment():
         assert info["_final"].dtype == bool and not info["_final"].any()
     finally:
         env.close()
+
+
+def test_gymnasiums_vector_wrappers_take_the_vector_environment():
+    """It was no gymnasium.vector.VectorEnv: RecordEpisodeStatistics, NormalizeReward and the like refused it, and
+    it had no batched action_space to sample."""
+    env = gymnasium.wrappers.vector.RecordEpisodeStatistics(kage.make_vec(NOISY_SKELETON, 3))
+    try:
+        assert isinstance(env.unwrapped, gymnasium.vector.VectorEnv) and isinstance(env.unwrapped, kage.VecEnv)
+        assert env.action_space == gymnasium.spaces.MultiDiscrete([8, 8, 8])
+        assert env.observation_space.shape == (3, *env.single_observation_space.shape)
+        env.reset(seed=1)
+        env.action_space.seed(0)
+        for step in range(1, 41):
+            *_, info = env.step(env.action_space.sample())
+            if "episode" in info:
+                break
+        # NOISY_SKELETON's episodes end at 40 steps; the wrapper sums the rewards of each.
+        assert step == 40 and info["_episode"].all() and info["episode"]["l"].tolist() == [40, 40, 40]
+        assert np.allclose(info["episode"]["r"], info["final_info"]["return"])
+    finally:
+        env.close()
+
+
+def test_without_gymnasium_the_spaces_are_its_reduced_ones():
+    code = ("import sys; sys.modules['gymnasium'] = None\n"
+            "from kage import spaces\n"
+            "a = spaces.batched(spaces.action_space(), 3); o = spaces.batched(spaces.observation_space(4, 5), 3)\n"
+            "a.seed(0); x = a.sample()\n"
+            "print(spaces.VectorEnvBase is object, a, o.shape, x.shape, a.contains(x), a.contains([0, 8, 0]))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[0] == "True MultiDiscrete([8, 8, 8]) (3, 4, 5, 3) (3,) True False"
 
 
 def test_flags_and_masks_are_bool_and_index_as_masks():
