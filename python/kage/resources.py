@@ -76,6 +76,10 @@ def _shipped(kind: str, value: str) -> str:
     path = folder / f"{name}.yaml"
     if path.is_file():
         return str(path)
+    if name and (folder / name).is_dir():  # a folder of shipped ones: name one of them
+        inside = [f"{name}/{n}" for n in _names(folder / name)]
+        raise FileNotFoundError(f"{kind[:-1]} '{value}' is a folder of shipped {kind}, not one: name one of them "
+                                f"({', '.join(inside[:8])}{', ...' if len(inside) > 8 else ''})")
     names = _names(folder)
     near = difflib.get_close_matches(name, names, n=5, cutoff=0.5)
     hint = f"; near names: {', '.join(near)}" if near else f"; shipped {kind}: {', '.join(names[:8])}, ..."

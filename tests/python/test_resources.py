@@ -41,6 +41,15 @@ def test_an_unknown_name_lists_near_ones():
         resources.suite_path("kage_bnch")
 
 
+def test_a_folder_of_shipped_configs_names_what_it_holds(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # where configs/kage_bench is no path: it was called "neither a path nor a name"
+    with pytest.raises(FileNotFoundError) as e:
+        resources.config_path("configs/kage_bench/bases")
+    assert str(e.value) == ("config 'configs/kage_bench/bases' is a folder of shipped configs, not one: name one of "
+                            "them (kage_bench/bases/image_shape, kage_bench/bases/image_skeleton, "
+                            "kage_bench/bases/shape_black, kage_bench/bases/skeleton_black)")
+
+
 def test_make_vec_takes_a_shipped_name():
     import kage
 
