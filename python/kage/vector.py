@@ -6,6 +6,7 @@ stays allocated while it exists, but its contents are overwritten by the next ``
 copy what you keep (``obs.copy()``, ``tensor.clone()``).
 """
 import contextlib
+import json
 import os
 import threading
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
@@ -261,17 +262,19 @@ class VecEnv(spaces.VectorEnvBase):
     @property
     def resolved_spec(self) -> dict:
         """The resolved Spec the batch runs, as ``kagec resolve`` prints it (``{"config": {...}, "sha256": ...}``;
-        Gymnasium's ``spec`` is another thing, an EnvSpec). Resolved on first use and checked against the
+        Gymnasium's ``spec`` is another thing, an EnvSpec; a kagec compile directory's is its spec.json). Resolved
+        on first use and checked against the
         batch's ``spec_hash``: a config file edited since ``make_vec`` raises instead of describing another game.
         A mixture runs several: see ``resolved_specs``."""
         if not isinstance(self.config, str):
             raise ValueError(f"this batch is a mixture of {len(self.configs)} configs, each with its own Spec: "
                              "resolved_specs lists them")
         if self._spec is None:
-            if os.path.isdir(self.config):
-                raise ValueError(f"{self.config} is a kagec compile directory, which holds no Spec: resolve the YAML "
-                                 "config it was compiled from (kage.front_end.resolve)")
-            spec = front_end.resolve(self.config, self._asset_root)
+            if os.path.isdir(self.config):  # a kagec compile directory: the Spec it was compiled from
+                with open(os.path.join(self.config, "spec.json")) as f:
+                    spec = json.load(f)
+            else:
+                spec = front_end.resolve(self.config, self._asset_root)
             if spec["sha256"] != self.spec_hash:
                 raise RuntimeError(f"{self.config} changed since this environment was made (spec "
                                    f"{self.spec_hash[:12]} then, {spec['sha256'][:12]} now): make the environment again")

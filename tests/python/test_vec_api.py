@@ -1,4 +1,6 @@
 """make_vec's result: shapes, dtypes, spaces, metadata, seeding and subset reset."""
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -88,3 +90,11 @@ def test_views_outlive_close():
     expected = obs.copy()
     env.close()
     assert np.array_equal(obs, expected), "an output view keeps the runtime's memory alive"
+
+
+def test_a_compile_directorys_resolved_spec_is_its_spec_json(tmp_path, kagec):
+    """It raised "holds no Spec" although the directory holds spec.json, the Spec it was compiled from."""
+    compiled = tmp_path / "simplest"
+    subprocess.run([kagec, "compile", SIMPLEST, "-o", str(compiled), "--no-gpu"], check=True, capture_output=True)
+    with kage.make_vec(str(compiled), 2) as env:
+        assert env.resolved_spec == kage.front_end.resolve(SIMPLEST)
