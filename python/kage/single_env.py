@@ -42,6 +42,7 @@ class SingleEnv(gymnasium.Env):
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[Dict[str, Any]] = None
               ) -> Tuple[np.ndarray, Dict[str, Any]]:
+        self._live()
         super().reset(seed=seed)
         if options:
             raise ValueError(f"reset: unknown options {sorted(options)} (a single environment takes none)")
@@ -54,6 +55,7 @@ class SingleEnv(gymnasium.Env):
         return self._keep(obs[0]), _row(info)
 
     def step(self, action) -> Tuple[np.ndarray, float, bool, bool, Dict[str, Any]]:
+        self._live()
         if not self.action_space.contains(action):
             raise ValueError(f"action {action!r}: an integer in 0..{self.action_space.n - 1}")
         obs, reward, terminated, truncated, info = self._batch.step(np.array([action], dtype=np.int32))
@@ -70,6 +72,11 @@ class SingleEnv(gymnasium.Env):
 
     def close(self) -> None:
         self._batch.close()
+
+    def _live(self) -> None:
+        if self._batch.closed:  # the batch's own message would name kage.make_vec, not how this one was made
+            raise RuntimeError(f"this environment is closed: make a new one with gymnasium.make({ENV_ID!r}, "
+                               "config=...)")
 
     def _keep(self, frame) -> np.ndarray:
         self._frame = np.array(frame, copy=True)

@@ -161,6 +161,16 @@ def test_unseeded_single_environments_differ_and_seeded_ones_repeat():
             env.close()
 
 
+def test_a_closed_single_environment_names_how_to_make_another():
+    env = gymnasium.make("kage/KAGE-v0", config=SIMPLEST, disable_env_checker=True)
+    env.reset(seed=0)
+    env.close()
+    env.close()  # twice is harmless
+    for call in (env.reset, lambda: env.step(0)):
+        with pytest.raises(RuntimeError, match=r"closed: make a new one with gymnasium\.make\('kage/KAGE-v0', "):
+            call()
+
+
 def test_a_make_without_config_or_with_a_bad_one_names_the_fix():
     """It raised Python's "missing 1 required positional argument: 'config'", "expected str, bytes or
     os.PathLike object, not int", or make_vec's "unexpected keyword argument 'render_mode'"."""
