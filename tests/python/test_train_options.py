@@ -98,3 +98,13 @@ def test_an_eval_config_that_changes_the_hidden_game_is_warned_of(tmp_path, caps
     assert "is not certified against the train config: latent keys change (the hidden game differs)" in err
     assert "(certificates/long_episode.yaml.json)" in err
     assert json.loads((out / "certificates" / "long_episode.yaml.json").read_text())["certified"] is False
+
+
+def test_help_shows_each_default_once(capsys):
+    with pytest.raises(SystemExit):
+        train.parse_args(["--help"])
+    text = " ".join(capsys.readouterr().out.split())  # argparse wraps lines
+    assert "environment steps of the run (default: 25000000)" in text
+    assert "(alpha_r; 0.1 in Raileanu et al. 2021) (default: 0.1)" in text
+    assert "(default: None)" not in text and "(default: [])" not in text
+    assert "CPU threads (default: all cores) (default" not in text  # a help that names its default keeps its own

@@ -143,10 +143,21 @@ PER_RUN = ("train_config_path", "train_config_paths", "train_weights", "train_sc
            "eval_config_paths", "eval_config_labels", "seed", "out", "exp_name")
 
 
+class DefaultsShown(argparse.HelpFormatter):
+    """--help with each flag's default, where its help does not already name one and it has a value."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if "default" in text or action.default in (None, "", [], argparse.SUPPRESS) or not action.option_strings:
+            return text
+        return text + " (default: %(default)s)"
+
+
 def parse_args(argv: Optional[List[str]] = None) -> Args:
     """The flags of Args: --snake-case names, booleans as --flag / --no-flag."""
     # No abbreviations: kage.bench refuses the per-run flags by their full names, which an abbreviation would pass.
-    parser = argparse.ArgumentParser(prog=PROG, description=DESCRIPTION, allow_abbrev=False)
+    parser = argparse.ArgumentParser(prog=PROG, description=DESCRIPTION, allow_abbrev=False,
+                                     formatter_class=DefaultsShown)
     for f in dataclasses.fields(Args):
         flag = "--" + f.name.replace("_", "-")
         default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default
