@@ -78,6 +78,7 @@ int cmd_render(const std::vector<std::string>& args, CommandIo& io) {
   uint64_t seed = 0;
   int64_t steps = 100, every = 10;
   bool force = false;
+  app.option_defaults()->always_capture_default();  // --help shows --seed 0, --steps 100, --every 10, --policy right
   app.add_option("config", config, "config file")->required();
   app.add_option("--seed", seed, "environment seed");
   app.add_option("--steps", steps, "steps to run after the reset")->check(CLI::NonNegativeNumber);
