@@ -263,8 +263,8 @@ class VecEnv(spaces.VectorEnvBase):
     def resolved_spec(self) -> dict:
         """The resolved Spec the batch runs, as ``kagec resolve`` prints it (``{"config": {...}, "sha256": ...}``;
         Gymnasium's ``spec`` is another thing, an EnvSpec; a kagec compile directory's is its spec.json). Resolved
-        on first use and checked against the
-        batch's ``spec_hash``: a config file edited since ``make_vec`` raises instead of describing another game.
+        on first use and checked against the batch's ``spec_hash``: a config file edited since ``make_vec`` raises
+        instead of describing another game.
         A mixture runs several: see ``resolved_specs``."""
         if not isinstance(self.config, str):
             raise ValueError(f"this batch is a mixture of {len(self.configs)} configs, each with its own Spec: "

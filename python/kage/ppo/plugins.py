@@ -219,6 +219,7 @@ def global_generators(device) -> dict:
 
 
 def same_state(a, b) -> bool:
+    """Whether two states of global_generators' (tensors, numpy's tuple with its key array, Python's tuples) match."""
     if torch.is_tensor(a):
         return torch.equal(a, b)
     if isinstance(a, (tuple, list)):
