@@ -84,7 +84,12 @@ def _native_integers(a: np.ndarray, copy_strided: bool = False) -> np.ndarray:
         # A native, aligned int64 copy: the binding reads only native int32/int64 whose byte stride is a
         # multiple of the item size, so a field of a packed structured array, another byte order or a
         # misaligned buffer is copied here. int64 holds every other integer kind's values (uint64 above 2**63
-        # turns negative: still refused), so the runtime's range check sees them unchanged.
+        # would turn negative: refused here, with their value), so the runtime's range check sees them unchanged.
+        if a.dtype.kind == "u" and a.size and a.max() > np.iinfo(np.int64).max:
+            at = tuple(int(i) for i in np.argwhere(a > np.iinfo(np.int64).max)[0])
+            where = f"batch {at[0]} (none stepped): " if len(at) == 2 else ""
+            raise ValueError(f"kage: {where}action {int(a[at])} for environment {at[-1]}: "
+                             f"{native().action_range_text()}")
         a = a.astype(np.int64)
     return a
 

@@ -57,6 +57,7 @@ def test_cuda_without_a_gpu_says_use_cpu():
     (np.array([0, 1, 8, 2]), "action 8 for environment 2"),
     (np.array([0, -1, 2, 2]), "action -1 for environment 1"),
     (torch.tensor([0, 1, 2, 9]), "action 9 for environment 3"),
+    (np.array([0, 2**63, 2, 1], dtype=np.uint64), "action 9223372036854775808 for environment 1"),  # was negative
     ([0, 1, 2], r"expected \(4,\)"),
 ])
 def test_bad_actions(env, actions, match):

@@ -76,6 +76,8 @@ def test_int32_rows_and_a_strided_view_step_as_int64_rows():
      "batch 1 has 7 environments, batch 0 has 6: step batches of one size together"),
     (lambda e: e[:2], np.full((2, N), 8, np.int64), ValueError,
      "action 8 for environment 0: an action is an integer in 0..7"),
+    (lambda e: e[:2], np.array([[0] * N, [0, 0, 2**64 - 1, 0, 0, 0]], np.uint64), ValueError,
+     "batch 1 (none stepped): action 18446744073709551615 for environment 2: an action is an integer in 0..7"),
 ])
 def test_misuse_is_refused_before_any_batch_steps(envs, actions, error, text):
     made = batches()
