@@ -75,8 +75,8 @@ def split_warned(num_envs: int, weights: Sequence[Fraction], configs: Sequence[s
     if unrun_configs:
         names = ", ".join(f"configs[{k}] {configs[k]!r} (weight {float(weights[k]):g})" for k in unrun_configs)
         warnings.warn(f"{caller}: {num_envs} environments split as {list(counts)} leave {names} none, so "
-                      f"{'it runs' if len(unrun_configs) == 1 else 'they run'} nowhere; give more environments or a larger "
-                      "weight (kage.mixture gives the rule)", UserWarning, stacklevel=3)
+                      f"{'it runs' if len(unrun_configs) == 1 else 'they run'} nowhere; give more environments or a "
+                      "larger weight (kage.mixture gives the rule)", UserWarning, stacklevel=3)
     return counts
 
 

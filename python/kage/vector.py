@@ -378,8 +378,9 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
             raise ValueError(f"asset_root={asset_root!r:.80}: a directory path (str or os.PathLike)")
         asset_root = os.fsdecode(asset_root)
         if not os.path.isdir(asset_root):  # else a config without assets ignores it, one with assets blames the YAML
-            raise FileNotFoundError(f"asset_root={asset_root!r}: no such directory; it replaces the config's own folder "
-                                    "as the base of its relative asset paths: give that directory, or leave it out")
+            raise FileNotFoundError(f"asset_root={asset_root!r}: no such directory; it replaces the config's own "
+                                    "folder as the base of its relative asset paths: give that directory, or leave "
+                                    "it out")
     # Paths, or shipped configs' names; FileNotFoundError names near ones.
     configs = [resources.config_path(c) for c in configs]
     if mixture:

@@ -16,6 +16,8 @@ from kage import resources
 from kage.ppo import plugins, schedule
 
 DRAC_COEF = 0.1  # DrAC's weight of its regularisers, its paper's default
+AUGMENT_MODES = ("drac", "rollout", "update")
+DEFAULT_AUGMENT_MODE = "drac"  # --augment-mode where --augment is given alone (a run started in another resumes in it)
 
 # Flags whose repetition reads as "both" but would keep the last: refused, with what to do instead.
 ONE_EACH = {"--augment": "a run takes one augmentation; to combine several, write one function that calls each "
@@ -59,7 +61,7 @@ class Args:
         "help": "how --augment trains: drac (the default: PPO on plain frames plus DrAC's policy and value "
                 "regularisers), rollout (the policy acts on augmented frames, and the update reuses them) or update "
                 "(the update's minibatches only: unsound for strong augmentations, kept for comparison)",
-        "choices": ("drac", "rollout", "update")})
+        "choices": AUGMENT_MODES})
     drac_coef: float = field(default=DRAC_COEF, metadata={
         "help": "weight of DrAC's regularisers under --augment-mode drac (alpha_r; 0.1 in Raileanu et al. 2021)"})
     # PPO (§2.1: the defaults of ppo_jax.py; the benchmark overrides none)
@@ -325,9 +327,9 @@ def validate(args: Args) -> List[str]:
     if args.augment_mode and not args.augment:
         problems.append(f"--augment-mode {args.augment_mode} needs --augment module:fn (e.g. "
                         "kage.ppo.augment:color_jitter), or drop --augment-mode")
-    elif args.augment_mode not in (None, "drac", "rollout", "update"):
+    elif args.augment_mode is not None and args.augment_mode not in AUGMENT_MODES:
         problems.append(f"--augment-mode {args.augment_mode!r}: use drac, rollout or update")
-    mode = args.augment_mode or ("drac" if args.augment else None)
+    mode = args.augment_mode or (DEFAULT_AUGMENT_MODE if args.augment else None)
     if args.drac_coef != DRAC_COEF and mode != "drac":
         problems.append(f"--drac-coef {args.drac_coef} weighs DrAC's regularisers, which run only with --augment "
                         f"under --augment-mode drac (the default){f', not {mode}' if mode else ''}: drop --drac-coef, "

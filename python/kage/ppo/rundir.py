@@ -40,7 +40,7 @@ from kage import front_end, resources
 from kage.errors import ConfigError
 from kage.fields import SUCCESS_SHOWN
 from kage.ppo import checkpoint, plugins, schedule
-from kage.ppo.args import configs_of, first_train_config, stages_of, training_label
+from kage.ppo.args import DEFAULT_AUGMENT_MODE, configs_of, first_train_config, stages_of, training_label
 from kage.util.files import atomic_write, named_errors, read_json_record, remove_strays, safe, write_json
 from kage.util.lock import DirectoryLock, LockHeld
 
@@ -456,12 +456,12 @@ def with_augment_mode(args):
     has a run.json that records an --augment, else drac whenever --augment is given."""
     if args.augment_mode or not args.augment:
         return args
-    mode = "drac"
+    mode = DEFAULT_AUGMENT_MODE
     path = os.path.join(args.out or default_dir(args), "run.json")
     if os.path.isfile(path):
         recorded, problem = read_json_record(path, run_json_problem)
         if not problem and recorded["args"].get("augment"):
-            mode = recorded_mode(recorded["args"]) or "drac"
+            mode = recorded_mode(recorded["args"]) or DEFAULT_AUGMENT_MODE
     return dataclasses.replace(args, augment_mode=mode)
 
 
