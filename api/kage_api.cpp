@@ -109,7 +109,21 @@ struct Loaded {
   LoweredConfig config;
 };
 
-std::optional<Loaded> load_yaml(const std::string& path, const Options& options, std::string* error) {
+/// The text of `diags` (warnings alone where it holds no error), as kagec prints it.
+std::string diagnostics_text(const DiagEngine& diags) {
+  std::ostringstream s;
+  print_text(diags, s);
+  return s.str();
+}
+
+/// The asset loader's warnings, one a line, after `warnings`.
+void add_asset_warnings(const AssetPackResult& assets, const std::string& who, std::string* warnings) {
+  for (const std::string& w : assets.warnings) *warnings += who + ": warning: " + w + "\n";
+}
+
+/// The lowered config of a YAML file; its warnings (kagec's located text) into `warnings`.
+std::optional<Loaded> load_yaml(const std::string& path, const Options& options, std::string* error,
+                                std::string* warnings = nullptr) {
   SourceManager sources;
   DiagEngine diags(sources);
   DiskFileReader reader;
@@ -117,15 +131,14 @@ std::optional<Loaded> load_yaml(const std::string& path, const Options& options,
   if (!options.asset_root.empty()) ro.asset_root = options.asset_root;
   LoweredFile loaded = load_lowered(path, ro, sources, reader, diags);
   if (!loaded.spec) {
-    std::ostringstream s;
-    print_text(diags, s);
-    fail(error, s.str() + "kage::open: no Spec for '" + path + "'");
+    fail(error, diagnostics_text(diags) + "kage::open: no Spec for '" + path + "'");
     return std::nullopt;
   }
   if (!loaded.ok()) {
     fail(error, loaded.lower_errors);
     return std::nullopt;
   }
+  if (warnings) *warnings = diagnostics_text(diags);
   return Loaded{loaded.spec->sha256(), std::move(*loaded.config)};
 }
 
@@ -440,7 +453,8 @@ bool fits_in_memory(const LatentParams& latent, const VisualParams& visual, cons
 }
 
 /// open() without the final error kind: sets *kind where a failure has a specific one.
-std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::string* error, ErrorKind* kind) {
+std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::string* error, ErrorKind* kind,
+                              std::string* warnings) {
   if (o.num_envs <= 0 || o.num_threads <= 0)
     return *kind = ErrorKind::kUsage, fail(error, "kage::open: num_envs and num_threads must be positive"), nullptr;
 #if !defined(KAGE_API_HAVE_CUDA)
@@ -475,12 +489,13 @@ std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::st
     return open_gpu(l, *source, fatbin, std::move(*pack), o, error, kind);
 #endif
   }
-  std::optional<Loaded> l = load_yaml(path, o, error);
+  std::optional<Loaded> l = load_yaml(path, o, error, warnings);
   if (!l) return *kind = ErrorKind::kConfig, nullptr;
   if (o.backend == Backend::kCpu && !fits_in_memory(l->config.latent, l->config.visual, o, error))
     return *kind = ErrorKind::kUsage, nullptr;
   AssetPackResult assets = load_asset_pack(l->config.assets);
   if (!assets.ok()) return fail(error, "kage::open: " + assets.error), nullptr;
+  add_asset_warnings(assets, "kage::open", warnings);
   if (o.backend == Backend::kCpu)
     return std::make_unique<HostEnv>(nullptr, generic_host_kernels(l->config.latent, l->config.visual),
                                      std::move(*assets.pack), o, l->spec_hash);
@@ -494,7 +509,7 @@ std::unique_ptr<Env> open_any(const std::string& path, const Options& o, std::st
 
 /// open_mixture() without the final error kind (see open_any).
 std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, const Options& o, std::string* error,
-                                      ErrorKind* kind) {
+                                      ErrorKind* kind, std::string* warnings) {
   *kind = ErrorKind::kUsage;
   int64_t total = 0;
   for (const MixturePart& p : parts) {
@@ -520,11 +535,8 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
   std::vector<std::string> paths;
   for (const MixturePart& p : parts) paths.push_back(p.path);
   const std::optional<std::vector<Spec>> specs = analyze_mixture(paths, ro, sources, reader, diags);
-  if (!specs) {
-    std::ostringstream s;
-    print_text(diags, s);
-    return fail(error, s.str() + "kage::open_mixture: not a mixture of these configs"), nullptr;
-  }
+  if (!specs) return fail(error, diagnostics_text(diags) + "kage::open_mixture: not a mixture of these configs"), nullptr;
+  *warnings = diagnostics_text(diags);
 #if !defined(KAGE_API_HAVE_CUDA)
   if (o.backend == Backend::kGpu)
     return *kind = ErrorKind::kDevice,
@@ -548,6 +560,7 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
   for (const LoweredConfig& c : lowered) {
     AssetPackResult assets = load_asset_pack(c.assets);
     if (!assets.ok()) return fail(error, "kage::open_mixture: " + assets.error), nullptr;
+    add_asset_warnings(assets, "kage::open_mixture", warnings);
     packs.push_back(std::move(*assets.pack));
   }
 #if defined(KAGE_API_HAVE_CUDA)
@@ -579,10 +592,12 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
 }  // namespace
 
 std::unique_ptr<Env> open_mixture(const std::vector<MixturePart>& parts, const Options& o, std::string* error,
-                                  ErrorKind* kind_out) {
+                                  ErrorKind* kind_out, std::string* warnings_out) {
   ErrorKind ignored = ErrorKind::kOther;
   ErrorKind* kind = kind_out ? kind_out : &ignored;
-  std::unique_ptr<Env> env = open_mixture_any(parts, o, error, kind);
+  std::string warnings;
+  std::unique_ptr<Env> env = open_mixture_any(parts, o, error, kind, &warnings);
+  if (warnings_out) *warnings_out = env ? warnings : std::string();
   if (env) *kind = ErrorKind::kNone;
   return env;
 }
@@ -679,11 +694,14 @@ bool gpu_backend_built() {
 #endif
 }
 
-std::unique_ptr<Env> open(const std::string& path, const Options& o, std::string* error, ErrorKind* kind_out) {
+std::unique_ptr<Env> open(const std::string& path, const Options& o, std::string* error, ErrorKind* kind_out,
+                          std::string* warnings_out) {
   ErrorKind ignored = ErrorKind::kOther;
   ErrorKind* kind = kind_out ? kind_out : &ignored;
   *kind = ErrorKind::kOther;
-  std::unique_ptr<Env> env = open_any(path, o, error, kind);
+  std::string warnings;
+  std::unique_ptr<Env> env = open_any(path, o, error, kind, &warnings);
+  if (warnings_out) *warnings_out = env ? warnings : std::string();
   if (env) *kind = ErrorKind::kNone;
   return env;
 }

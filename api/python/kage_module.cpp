@@ -425,18 +425,19 @@ class PyEnv {
   throw py::error_already_set();
 }
 
-/// The batch `open_fn(error, kind)` opens (without the GIL), or its failure raised as the class of its kind.
+/// (the batch `open_fn(error, kind, warnings)` opens (without the GIL), its config's warnings as kagec prints
+/// them), or its failure raised as the class of its kind.
 template <class Open>
-PyEnv opened(const Open& open_fn) {
-  std::string error;
+py::tuple opened(const Open& open_fn) {
+  std::string error, warnings;
   kage::ErrorKind kind = kage::ErrorKind::kOther;
   std::unique_ptr<kage::Env> env;
   {
     py::gil_scoped_release release;
-    env = open_fn(&error, &kind);
+    env = open_fn(&error, &kind, &warnings);
   }
   if (!env) raise_kind(kind, error);
-  return PyEnv(std::shared_ptr<kage::Env>(std::move(env)));
+  return py::make_tuple(PyEnv(std::shared_ptr<kage::Env>(std::move(env))), text(warnings));
 }
 
 /// kage::compile_kernels without the GIL: (compiled, cached), or its failure raised as the class of its kind.
@@ -455,7 +456,7 @@ py::tuple compile_kernels(const std::vector<std::string>& paths, const std::stri
   return py::make_tuple(done->compiled, done->cached);
 }
 
-PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& device, int32_t num_threads,
+py::tuple open_env(const std::string& path, int32_t num_envs, const std::string& device, int32_t num_threads,
                const std::string& asset_root, uintptr_t stream) {
   kage::Options o;
   o.backend = device == "cuda" ? kage::Backend::kGpu : kage::Backend::kCpu;
@@ -463,10 +464,12 @@ PyEnv open_env(const std::string& path, int32_t num_envs, const std::string& dev
   o.num_threads = num_threads;
   o.asset_root = asset_root;
   o.stream = reinterpret_cast<void*>(stream);
-  return opened([&](std::string* error, kage::ErrorKind* kind) { return kage::open(path, o, error, kind); });
+  return opened([&](std::string* error, kage::ErrorKind* kind, std::string* warnings) {
+    return kage::open(path, o, error, kind, warnings);
+  });
 }
 
-PyEnv open_mixture(const std::vector<std::string>& paths, const std::vector<int32_t>& counts, const std::string& device,
+py::tuple open_mixture(const std::vector<std::string>& paths, const std::vector<int32_t>& counts, const std::string& device,
                    int32_t num_threads, const std::string& asset_root, uintptr_t stream) {
   if (paths.size() != counts.size()) raise_value_error("open_mixture: one environment count per config");
   std::vector<kage::MixturePart> parts;
@@ -476,7 +479,9 @@ PyEnv open_mixture(const std::vector<std::string>& paths, const std::vector<int3
   o.num_threads = num_threads;
   o.asset_root = asset_root;
   o.stream = reinterpret_cast<void*>(stream);
-  return opened([&](std::string* error, kage::ErrorKind* kind) { return kage::open_mixture(parts, o, error, kind); });
+  return opened([&](std::string* error, kage::ErrorKind* kind, std::string* warnings) {
+    return kage::open_mixture(parts, o, error, kind, warnings);
+  });
 }
 
 /// The JSON of a front-end call, or its diagnostics raised as the config error class.
@@ -541,7 +546,7 @@ PYBIND11_MODULE(_kage, m) {
     return out;
   }, "(name, numpy dtype, meaning) of every info field, in order.");
   m.def("open", &open_env, py::arg("path"), py::arg("num_envs"), py::arg("device"), py::arg("num_threads"),
-        py::arg("asset_root"), py::arg("stream"));
+        py::arg("asset_root"), py::arg("stream"), "kage::open: (the batch, its config's warnings as text).");
   m.def("step_rows", &PyEnv::step_rows, py::arg("envs"), py::arg("actions"),
         "Steps envs[i] with row i of actions (a 2-D numpy array, or a DLPack capsule ordered for envs[0]'s "
         "stream) in one call.");
@@ -549,7 +554,7 @@ PYBIND11_MODULE(_kage, m) {
         "kage::compile_kernels: the configs' GPU kernels compiled into the kernel cache, side by side; "
         "(compiled, cached).");
   m.def("open_mixture", &open_mixture, py::arg("paths"), py::arg("counts"), py::arg("device"), py::arg("num_threads"),
-        py::arg("asset_root"), py::arg("stream"));
+        py::arg("asset_root"), py::arg("stream"), "kage::open_mixture: (the batch, its configs' warnings as text).");
 
   py::class_<DeviceArray>(m, "DeviceArray",
                           "A [N, ...] array in GPU memory, owned by an environment: take it with "

@@ -45,33 +45,36 @@ Diagnostic& DiagEngine::report(Rule rule, Range range, std::string message, std:
   return diags_.back();
 }
 
-const std::map<uint32_t, std::string_view>& DiagEngine::disable_comments(FileId file) const {
+const std::multimap<uint32_t, std::string_view>& DiagEngine::disable_comments(FileId file) const {
   const auto found = disable_comments_.find(file);
   if (found != disable_comments_.end()) return found->second;
-  std::map<uint32_t, std::string_view>& lines = disable_comments_[file];
+  std::multimap<uint32_t, std::string_view>& lines = disable_comments_[file];
   const std::string_view text = sources_.text(file);
+  auto rule_list = [&](size_t at) {
+    const std::string_view list = text.substr(at);
+    return list.substr(0, list.find_first_of(" \t#\r\n"));
+  };
   static constexpr std::string_view kMarker = "kagec: disable=";
   for (size_t at = text.find(kMarker); at != std::string_view::npos; at = text.find(kMarker, at + 1)) {
-    std::string_view list = text.substr(at + kMarker.size());
-    list = list.substr(0, list.find_first_of(" \t#\r\n"));
     const uint32_t line = sources_.line_col(Loc{file, static_cast<uint32_t>(at)}).line;
-    lines.emplace(line, list);  // the first comment of a line counts, as before
+    if (!lines.count(line)) lines.emplace(line, rule_list(at + kMarker.size()));  // a line's first comment counts
   }
+  static constexpr std::string_view kFileMarker = "kagec: disable-file=";
+  for (size_t at = text.find(kFileMarker); at != std::string_view::npos; at = text.find(kFileMarker, at + 1))
+    lines.emplace(kWholeFile, rule_list(at + kFileMarker.size()));
   return lines;
 }
 
-// `# kagec: disable=RULE[,RULE]` on the diagnostic's line or the line above.
+// `# kagec: disable=RULE[,RULE]` on the diagnostic's line or the line above, or `# kagec: disable-file=RULE[,RULE]`
+// anywhere in the diagnostic's file.
 bool DiagEngine::suppressed(const Diagnostic& d) const {
   const char* id = rule_info(d.rule).id;
   if (disabled_.count(id)) return true;
   if (no_warnings_ && d.severity == Severity::Warning) return true;
   if (!d.range.begin.valid()) return false;
-  const std::map<uint32_t, std::string_view>& comments = disable_comments(d.range.begin.file);
+  const std::multimap<uint32_t, std::string_view>& comments = disable_comments(d.range.begin.file);
   if (comments.empty()) return false;
-  auto mentions = [&](uint32_t line) {
-    const auto it = comments.find(line);
-    if (it == comments.end()) return false;
-    std::string_view list = it->second;
+  auto lists = [&](std::string_view list) {
     while (!list.empty()) {
       const auto comma = list.find(',');
       if (list.substr(0, comma) == id) return true;
@@ -80,8 +83,12 @@ bool DiagEngine::suppressed(const Diagnostic& d) const {
     }
     return false;
   };
+  auto mentions = [&](uint32_t line) {
+    const auto [first, last] = comments.equal_range(line);
+    return std::any_of(first, last, [&](const auto& entry) { return lists(entry.second); });
+  };
   const uint32_t line = sources_.line_col(d.range.begin).line;
-  return mentions(line) || (line > 1 && mentions(line - 1));
+  return mentions(kWholeFile) || mentions(line) || (line > 1 && mentions(line - 1));
 }
 
 std::vector<Diagnostic> DiagEngine::sorted() const {

@@ -1,7 +1,8 @@
 // Diagnostics: what went wrong, where, under which stable rule id, and how to fix it.
 //
 // Passes report into a DiagEngine and keep going; the engine applies
-// --Werror, --disable and in-file `# kagec: disable=RULE` comments, and prints
+// --Werror, --disable and in-file `# kagec: disable=RULE` (a line) and `# kagec: disable-file=RULE` (the
+// whole file) comments, and prints
 // text (`file:line:col: severity: message [rule]`) or JSON.
 #pragma once
 
@@ -80,11 +81,13 @@ class DiagEngine {
 
  private:
   bool suppressed(const Diagnostic& d) const;
-  /// The `kagec: disable=` lists of a file by line, found in one pass over its text.
-  const std::map<uint32_t, std::string_view>& disable_comments(FileId file) const;
+  /// The `kagec: disable=` lists of a file by line (1-based), and its `kagec: disable-file=` lists under
+  /// kWholeFile, found in one pass over its text.
+  const std::multimap<uint32_t, std::string_view>& disable_comments(FileId file) const;
+  static constexpr uint32_t kWholeFile = 0;
   const SourceManager& sources_;
   std::vector<Diagnostic> diags_;
-  mutable std::map<FileId, std::map<uint32_t, std::string_view>> disable_comments_;
+  mutable std::map<FileId, std::multimap<uint32_t, std::string_view>> disable_comments_;
   std::set<std::string> disabled_;
   bool werror_ = false;
   bool no_warnings_ = false;

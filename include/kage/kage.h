@@ -171,9 +171,12 @@ class Env {
 
 
 /// Opens `path`: a directory with manifest.json (from `kagec compile`) or a YAML config. Null on error,
-/// with the message in `error` and its kind in `kind` (if given).
+/// with the message in `error` and its kind in `kind` (if given). `warnings` (if given) receives, on success,
+/// the YAML config's warnings located as `kagec lint` prints them (an inert setting, a reproduced quirk, ...)
+/// and the asset loader's, one per line; empty when there are none (a compiled directory was linted by
+/// `kagec compile`).
 std::unique_ptr<Env> open(const std::string& path, const Options& options, std::string* error,
-                          ErrorKind* kind = nullptr);
+                          ErrorKind* kind = nullptr, std::string* warnings = nullptr);
 
 /// One config of a mixture (open_mixture) and how many environments run it.
 struct MixturePart {
@@ -189,9 +192,9 @@ struct MixturePart {
 /// seed and actions. options.num_envs is ignored (the batch has the parts' sum). Either backend: on the GPU one
 /// device batch whose parts each run their config's own module (config_index() is then a device array), on the
 /// stream options.stream. The spec hash is a mixture's (the configs' Spec hashes and counts: kagec diff
-/// --mixture).
+/// --mixture). `warnings`: every config's, as open's.
 std::unique_ptr<Env> open_mixture(const std::vector<MixturePart>& parts, const Options& options, std::string* error,
-                                  ErrorKind* kind = nullptr);
+                                  ErrorKind* kind = nullptr, std::string* warnings = nullptr);
 
 /// Steps envs[i] by row i of the device array `actions` (element i * row_stride + env * actions.stride), as
 /// envs[i]->step(row i) would, byte for byte, with one step launch and one render launch per config over every

@@ -19,6 +19,7 @@ register_with_gymnasium()  # gymnasium.make("kage/KAGE-v0", ...), where Gymnasiu
 # name -> the module that defines it (loaded on first access, PEP 562).
 _LAZY = {
     "ConfigError": "kage.errors",
+    "ConfigWarning": "kage.errors",
     "Diagnostic": "kage.errors",
     "DeviceUnavailableError": "kage.errors",
     "INFO_FIELDS": "kage.vector",

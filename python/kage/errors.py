@@ -36,6 +36,13 @@ class ConfigError(ValueError):
         return [d for d in self.diagnostics if d.severity == "error"]
 
 
+class ConfigWarning(UserWarning):
+    """A config's warning from kagec's front end (an inert setting, a value outside the documented range, a
+    reproduced quirk of the original, ...), given by ``make_vec`` as ``kagec lint`` prints it, once per message
+    as Python's warning filters show warnings. Silence one rule in the config with a ``# kagec: disable=RULE``
+    comment on its line, or all of them with ``warnings.filterwarnings("ignore", category=kage.ConfigWarning)``."""
+
+
 class DeviceUnavailableError(RuntimeError):
     """``device="cuda"`` without a usable GPU (no driver, no device, or a build without CUDA)."""
 

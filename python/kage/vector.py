@@ -9,12 +9,14 @@ import contextlib
 import json
 import os
 import threading
+import warnings
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from kage import actions as _actions, fields, front_end, mixture as _mixture, resources, spaces
 from kage._native import native
+from kage.errors import ConfigWarning
 
 #: (name, numpy dtype, meaning) of every info field the runtime writes, in its order (runtime/info_fields.def).
 INFO_FIELDS = tuple(native().info_fields())
@@ -357,7 +359,9 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
     ``FileNotFoundError`` for a missing config, ``RuntimeError`` for ``device="cuda"`` without a usable
     GPU, ``ValueError`` for bad arguments and for a CPU batch that would need more than half of the
     machine's memory. The batch holds no episode until the first ``reset()`` (or ``load_state``): a step
-    before it raises ``RuntimeError``. Every argument is checked before anything is made.
+    before it raises ``RuntimeError``. Every argument is checked before anything is made. A YAML config's
+    warnings (``kagec lint``'s: an inert setting, a reproduced quirk, ...) and the asset loader's are given as
+    one ``kage.ConfigWarning``.
     """
     mixture = not isinstance(config, (str, bytes, os.PathLike))
     if mixture and not isinstance(config, (list, tuple)):
@@ -397,10 +401,13 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
     if mixture:
         # kagec's certificate first: a refusal (ConfigError, one located line) before anything is made.
         front_end.certify_mixture(configs, asset_root)
-        handle = native().open_mixture(configs, list(counts), device, int(threads), asset_root or "",
-                                       int(stream_handle))
+        handle, config_warnings = native().open_mixture(configs, list(counts), device, int(threads),
+                                                        asset_root or "", int(stream_handle))
     else:
-        handle = native().open(configs[0], int(num_envs), device, int(threads), asset_root or "", int(stream_handle))
+        handle, config_warnings = native().open(configs[0], int(num_envs), device, int(threads), asset_root or "",
+                                                int(stream_handle))
+    if config_warnings:
+        warnings.warn(ConfigWarning(config_warnings.rstrip()), stacklevel=2)
     return VecEnv(handle, configs if mixture else configs[0], seed, asset_root, counts)
 
 

@@ -128,3 +128,22 @@ TEST_CASE("open_mixture on the GPU backend refuses with kDevice where there is n
   CHECK(kind == kage::ErrorKind::kDevice);
   CHECK(error.find("GPU backend not built") != std::string::npos);
 }
+
+TEST_CASE("open and open_mixture give a YAML config's warnings, located, on success", "[integration][api][mixture]") {
+  const kage::test::TempConfig inert("open-warnings", "extends: " + kNearGoal + "\nbackground:\n  mode: black\n"
+                                                      "  parallax_factor: 0.8\n");
+  kage::Options o;
+  o.num_envs = 2;
+  std::string error, warnings = "stale";
+  REQUIRE(kage::open(inert.path(), o, &error, nullptr, &warnings));
+  CHECK(warnings.find(inert.path() + ":4:3: warning: 'background.parallax_factor' has no effect") != std::string::npos);
+  CHECK(warnings.find("[inert-setting]") != std::string::npos);
+  REQUIRE(kage::open(kNearGoal, o, &error, nullptr, &warnings));
+  CHECK(warnings.empty());
+  warnings = "stale";
+  REQUIRE(kage::open_mixture({{kNearGoal, 1}, {inert.path(), 1}}, o, &error, nullptr, &warnings));
+  CHECK(warnings.find(inert.path() + ":4:3: warning:") != std::string::npos);
+  warnings = "stale";  // a failure leaves none
+  CHECK_FALSE(kage::open(kRoot + "/no/such.yaml", o, &error, nullptr, &warnings));
+  CHECK(warnings.empty());
+}
