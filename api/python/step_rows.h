@@ -29,8 +29,9 @@ using StepTogether = std::function<void(const Actions& first_row, int64_t row_st
 
 /// Steps batches[i] with row i of `actions` ([len(batches), num_envs], int32 or int64), each as its own step
 /// call would: one call into the runtime for a list of batches (a pack's runs, an evaluation's configs). Host
-/// actions: a 2-D numpy array, native and aligned (kage.actions copies other layouts first), each row by its
-/// batch's own step; a failure leaves the earlier rows stepped (row_failure says so). Device actions: a DLPack
+/// actions: a 2-D numpy array, native and aligned (kage.actions copies other layouts first), every value checked
+/// to be in 0..7 before any batch steps, then each row by its batch's own step (a failure of a step itself leaves
+/// the earlier rows stepped: row_failure says so). Device actions: a DLPack
 /// capsule its producer ordered for batches[0]'s stream, every row by `together` (one launch pair per config
 /// over all the batches).
 void step_rows(const std::vector<RowBatch>& batches, const pybind11::object& actions, const StepTogether& together);

@@ -419,9 +419,10 @@ def step_batches(envs: Sequence[VecEnv], actions) -> None:
     ``outputs()``, the views ``step`` returns. Device actions step the GPU batches together: one step launch and
     one render launch per config over every batch (and mixture part) that runs it, on ``envs[0]``'s stream, the
     others' streams ordered before and after. What ``step`` would refuse before stepping (a shape, a dtype, a
-    device) is refused before any batch steps. A batch whose step fails (an action outside 0..7 in its row, or
-    reported by an earlier step of device actions) raises that error, naming the batch: with device actions no
-    batch has stepped, with host actions the batches before it have."""
+    device), and a host action outside 0..7 in any row, is refused before any batch steps, naming the batch. A
+    batch whose step fails (one never reset, or an out-of-range action reported by an earlier step of device
+    actions) raises that error, naming the batch: with device actions no batch has stepped, with host actions
+    the batches before it have."""
     envs = list(envs)
     if not envs or not all(isinstance(env, VecEnv) for env in envs):
         raise TypeError("step_batches: a non-empty list of kage.VecEnv (from kage.make_vec)")
