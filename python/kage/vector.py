@@ -127,8 +127,9 @@ class VecEnv(spaces.VectorEnvBase):
     render_mode = None
 
     def __init__(self, handle: "kage._kage.Env", config: Union[str, List[str]], seed: int,
-                 asset_root: Optional[str] = None, counts: Optional[Sequence[int]] = None):
+                 asset_root: Optional[str] = None, counts: Optional[Sequence[int]] = None, copy: bool = False):
         self._handle = handle
+        self._copy = copy  # reset, step and load_state return copies instead of the runtime's buffers
         self._lock = threading.Lock()  # one call at a time (see Threads above)
         self._caller: Optional[int] = None  # the thread inside a call, which a re-entrant call must not wait for
         self.config = config  # as make_vec was given it: a path, or a mixture's list of paths
@@ -192,7 +193,7 @@ class VecEnv(spaces.VectorEnvBase):
         if options:
             raise ValueError(f"reset: unknown options {sorted(options)} (known: 'reset_mask')")
         handle.reset(seeds, mask)
-        return self._obs, self._info_dict()
+        return self._returned((self._obs, self._info_dict()))
 
     def step(self, actions) -> Tuple[Any, Any, Any, Any, Dict[str, Any]]:
         """One step of every environment; ``actions``: [num_envs] integers in 0..7 (numpy, torch,
@@ -202,7 +203,7 @@ class VecEnv(spaces.VectorEnvBase):
             _actions.submit(handle, actions)
             # The runtime reads device actions when its kernel runs: keep them alive until the next step.
             self._last_actions = actions
-            return self._obs, self._reward, self._terminated, self._truncated, self._info_dict()
+            return self._returned((self._obs, self._reward, self._terminated, self._truncated, self._info_dict()))
 
     def outputs(self) -> Tuple[Any, Any, Any, Any, Dict[str, Any]]:
         """The arrays of the last reset or step, (obs, reward, terminated, truncated, info), without
@@ -243,7 +244,7 @@ class VecEnv(spaces.VectorEnvBase):
         data = _state_bytes(state)
         with self._one_call():
             self._live().load_state(data)
-            return self._obs, self._info_dict()
+            return self._returned((self._obs, self._info_dict()))
 
     def synchronize(self) -> None:
         """Waits for the batch's queued GPU work; raises ValueError if an earlier step had an
@@ -326,6 +327,16 @@ class VecEnv(spaces.VectorEnvBase):
             raise RuntimeError("this environment is closed: make a new one with kage.make_vec")
         return self._handle
 
+    def _returned(self, outputs: tuple) -> tuple:
+        """What reset, step and load_state return: the runtime's buffers, or under copy=True copies the caller
+        owns (host arrays only: make_vec refuses copy=True on the GPU)."""
+        if not self._copy:
+            return outputs
+
+        def owned(value):
+            return {k: owned(v) for k, v in value.items()} if isinstance(value, dict) else value.copy()
+        return tuple(owned(value) for value in outputs)
+
     def _info_dict(self) -> Dict[str, Any]:
         info = dict(self._info)
         info.update(self._final)
@@ -334,7 +345,7 @@ class VecEnv(spaces.VectorEnvBase):
 
 def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]], num_envs: int, device: str = "cpu",
              seed: int = 0, asset_root: Optional[str] = None, threads: Optional[int] = None, stream=None,
-             weights: Optional[Sequence[float]] = None) -> VecEnv:
+             weights: Optional[Sequence[float]] = None, copy: bool = False) -> VecEnv:
     """A batch of ``num_envs`` environments of ``config`` (a YAML file or a ``kagec compile``
     directory) on ``device`` ("cpu" or "cuda").
 
@@ -353,7 +364,10 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
     (default: relative to the file that names them). ``threads``: CPU worker threads (default: one
     per core; results do not depend on it). ``stream``: GPU only, the CUDA stream the batch queues its
     work on (a ``torch.cuda.Stream``, or a CUstream handle); default the legacy default stream, which
-    orders with PyTorch's default stream, so a learner on that stream needs no synchronisation.
+    orders with PyTorch's default stream, so a learner on that stream needs no synchronisation. ``copy``: CPU
+    only; True makes ``reset``, ``step`` and ``load_state`` return copies the caller owns (as Gymnasium's
+    ``SyncVectorEnv(copy=True)``), for code that keeps the arrays it is given; the default returns the
+    runtime's buffers, which the next step overwrites (no copy per step).
 
     Raises ``kage.ConfigError`` (with kagec's located diagnostics) for a config with errors,
     ``FileNotFoundError`` for a missing config, ``RuntimeError`` for ``device="cuda"`` without a usable
@@ -395,6 +409,11 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
         raise ValueError(f"threads={threads!r}: a positive integer up to {MAX_INT32}")
     if device == "cpu" and stream is not None:
         raise ValueError("stream= is for device='cuda'")
+    if not isinstance(copy, bool):
+        raise ValueError(f"copy={copy!r}: True or False")
+    if copy and device == "cuda":
+        raise ValueError("copy=True copies host arrays: on the GPU, clone what you keep (torch.from_dlpack(obs)"
+                         ".clone()), or leave copy out")
     stream_handle = 0 if stream is None else getattr(stream, "cuda_stream", stream)
     if not _is_integer(stream_handle) or not 0 <= stream_handle < 2**64:
         raise ValueError(f"stream={stream!r}: a torch.cuda.Stream or a CUstream handle (an integer)")
@@ -408,7 +427,7 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
                                                 int(stream_handle))
     if config_warnings:
         warnings.warn(ConfigWarning(config_warnings.rstrip()), stacklevel=2)
-    return VecEnv(handle, configs if mixture else configs[0], seed, asset_root, counts)
+    return VecEnv(handle, configs if mixture else configs[0], seed, asset_root, counts, copy)
 
 
 def step_batches(envs: Sequence[VecEnv], actions) -> None:

@@ -1,4 +1,4 @@
-"""make_vec's result: shapes, dtypes, spaces, metadata, seeding and subset reset."""
+"""make_vec's result: shapes, dtypes, spaces, metadata, seeding, subset reset and copy=True."""
 import subprocess
 
 import numpy as np
@@ -98,3 +98,25 @@ def test_a_compile_directorys_resolved_spec_is_its_spec_json(tmp_path, kagec):
     subprocess.run([kagec, "compile", SIMPLEST, "-o", str(compiled), "--no-gpu"], check=True, capture_output=True)
     with kage.make_vec(str(compiled), 2) as env:
         assert env.resolved_spec == kage.front_end.resolve(SIMPLEST)
+
+
+def test_copy_true_returns_arrays_the_next_step_leaves_alone():
+    with kage.make_vec(SIMPLEST, 4, copy=True) as env, kage.make_vec(SIMPLEST, 4) as views:
+        kept = [env.reset(seed=3)]
+        views.reset(seed=3)
+        expected = [[a.copy() for a in (views.outputs()[0], views.outputs()[4]["x"])]]
+        for _ in range(3):
+            kept.append(env.step(np.full(4, 6)))
+            views.step(np.full(4, 6))
+            expected.append([views.outputs()[0].copy(), views.outputs()[4]["x"].copy()])
+        for outputs, (obs, x) in zip(kept, expected):
+            assert np.array_equal(outputs[0], obs) and np.array_equal(outputs[-1]["x"], x)
+        assert not np.array_equal(kept[1][-1]["x"], kept[3][-1]["x"])  # they moved: the copies differ
+        assert not np.shares_memory(kept[1][-1]["final_info"]["return"], kept[2][-1]["final_info"]["return"])
+
+
+@pytest.mark.parametrize("kwargs, match", [({"copy": 1}, r"copy=1: True or False"),
+                                           ({"copy": True, "device": "cuda"}, r"copy=True copies host arrays")])
+def test_copy_is_checked(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        kage.make_vec(SIMPLEST, 2, **kwargs)
