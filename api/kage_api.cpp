@@ -535,7 +535,8 @@ std::unique_ptr<Env> open_mixture_any(const std::vector<MixturePart>& parts, con
   std::vector<std::string> paths;
   for (const MixturePart& p : parts) paths.push_back(p.path);
   const std::optional<std::vector<Spec>> specs = analyze_mixture(paths, ro, sources, reader, diags);
-  if (!specs) return fail(error, diagnostics_text(diags) + "kage::open_mixture: not a mixture of these configs"), nullptr;
+  if (!specs)
+    return fail(error, diagnostics_text(diags) + "kage::open_mixture: not a mixture of these configs"), nullptr;
   *warnings = diagnostics_text(diags);
 #if !defined(KAGE_API_HAVE_CUDA)
   if (o.backend == Backend::kGpu)
@@ -603,6 +604,12 @@ std::unique_ptr<Env> open_mixture(const std::vector<MixturePart>& parts, const O
 }
 
 const char* action_range_text() { return "an action is an integer in 0..7 (bit 0 left, bit 1 right, bit 2 jump)"; }
+
+std::string host_actions_problem(const Actions& a, int32_t num_envs) {
+  std::vector<int32_t> checked;
+  ErrorKind kind = ErrorKind::kNone;
+  return host_actions(a, num_envs, &checked, &kind);
+}
 
 const InfoFieldDesc* info_fields(int32_t* count) {
   *count = static_cast<int32_t>(std::size(kInfoFields));

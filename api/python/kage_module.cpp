@@ -457,7 +457,7 @@ py::tuple compile_kernels(const std::vector<std::string>& paths, const std::stri
 }
 
 py::tuple open_env(const std::string& path, int32_t num_envs, const std::string& device, int32_t num_threads,
-               const std::string& asset_root, uintptr_t stream) {
+                   const std::string& asset_root, uintptr_t stream) {
   kage::Options o;
   o.backend = device == "cuda" ? kage::Backend::kGpu : kage::Backend::kCpu;
   o.num_envs = num_envs;
@@ -469,8 +469,9 @@ py::tuple open_env(const std::string& path, int32_t num_envs, const std::string&
   });
 }
 
-py::tuple open_mixture(const std::vector<std::string>& paths, const std::vector<int32_t>& counts, const std::string& device,
-                   int32_t num_threads, const std::string& asset_root, uintptr_t stream) {
+py::tuple open_mixture(const std::vector<std::string>& paths, const std::vector<int32_t>& counts,
+                       const std::string& device, int32_t num_threads, const std::string& asset_root,
+                       uintptr_t stream) {
   if (paths.size() != counts.size()) raise_value_error("open_mixture: one environment count per config");
   std::vector<kage::MixturePart> parts;
   for (size_t k = 0; k < paths.size(); ++k) parts.push_back(kage::MixturePart{paths[k], counts[k]});

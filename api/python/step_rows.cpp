@@ -28,19 +28,16 @@ void step_host_rows(const std::vector<RowBatch>& batches, const py::array& a, in
     throw py::value_error("actions of shape (" + std::to_string(a.shape(0)) + ", " + std::to_string(a.shape(1)) +
                           "), " + expected_rows(batches.size(), n));
   const char* data = static_cast<const char*>(a.data());
-  // Every row's actions are checked before any batch steps, so that a bad one leaves every batch as it was.
-  for (size_t i = 0; i < batches.size(); ++i)
-    for (int32_t env = 0; env < n; ++env) {
-      const char* at = data + static_cast<py::ssize_t>(i) * a.strides(0) + static_cast<py::ssize_t>(env) * a.strides(1);
-      const int64_t v = item == 8 ? *reinterpret_cast<const int64_t*>(at) : *reinterpret_cast<const int32_t*>(at);
-      if (v < 0 || v > 7)
-        throw py::value_error(together_failure(i, batches.size(), "kage: action " + std::to_string(v) +
-                                                                      " for environment " + std::to_string(env) +
-                                                                      ": " + action_range_text()));
-    }
-  for (size_t i = 0; i < batches.size(); ++i)
-    batches[i].step(i, Actions{data + static_cast<py::ssize_t>(i) * a.strides(0), Memory::kHost,
-                               item == 8 ? DType::kInt64 : DType::kInt32, a.strides(1) / item});
+  auto row = [&](size_t i) {
+    return Actions{data + static_cast<py::ssize_t>(i) * a.strides(0), Memory::kHost,
+                   item == 8 ? DType::kInt64 : DType::kInt32, a.strides(1) / item};
+  };
+  // Every row is checked before any batch steps, so that a bad action leaves every batch as it was.
+  for (size_t i = 0; i < batches.size(); ++i) {
+    const std::string problem = host_actions_problem(row(i), n);
+    if (!problem.empty()) throw py::value_error(together_failure(i, batches.size(), "kage: " + problem));
+  }
+  for (size_t i = 0; i < batches.size(); ++i) batches[i].step(i, row(i));
 }
 
 /// What keeps device actions `d` from stepping `batches` (n environments each) by rows; empty if nothing.

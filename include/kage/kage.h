@@ -85,6 +85,11 @@ struct Actions {
   int64_t stride = 1;           ///< in elements
 };
 
+/// Why host actions `a` cannot step a batch of `num_envs` environments, as step() would refuse them ("action 8 for
+/// environment 3: " and action_range_text(), or a dtype other than int32 and int64), or empty: for a caller that
+/// checks several batches' actions before stepping any.
+std::string host_actions_problem(const Actions& a, int32_t num_envs);
+
 /// What a failure was about: open() reports it through `kind`, an Env's calls through last_error_kind().
 enum class ErrorKind {
   kNone,

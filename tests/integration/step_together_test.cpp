@@ -58,3 +58,14 @@ TEST_CASE("step_together refuses what it cannot step, naming the batch", "[integ
     CHECK(std::vector<uint8_t>(a->obs(), a->obs() + before.size()) == before);
   }
 }
+
+TEST_CASE("host_actions_problem says what step would refuse, and nothing for good actions", "[integration][api]") {
+  const std::vector<int64_t> good = {0, 7, 3}, bad = {0, 8, 3, 9};
+  CHECK(kage::host_actions_problem(kage::Actions{good.data(), kage::Memory::kHost, kage::DType::kInt64}, 3).empty());
+  CHECK(kage::host_actions_problem(kage::Actions{bad.data(), kage::Memory::kHost, kage::DType::kInt64}, 4) ==
+        std::string("action 8 for environment 1: ") + kage::action_range_text());
+  // Every other element (stride 2) of bad is 0 and 3: good.
+  CHECK(kage::host_actions_problem(kage::Actions{bad.data(), kage::Memory::kHost, kage::DType::kInt64, 2}, 2).empty());
+  CHECK(kage::host_actions_problem(kage::Actions{good.data(), kage::Memory::kHost, kage::DType::kFloat32}, 3) ==
+        "actions must be int32 or int64");
+}
