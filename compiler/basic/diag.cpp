@@ -24,6 +24,19 @@ const RuleInfo* find_rule(const std::string& id) {
   return nullptr;
 }
 
+std::vector<DisableComment> find_disable_comments(std::string_view text) {
+  std::vector<DisableComment> found;
+  static constexpr std::string_view kLine = "kagec: disable=", kFile = "kagec: disable-file=";
+  for (size_t at = text.find("kagec: disable"); at != std::string_view::npos; at = text.find("kagec: disable", at + 1)) {
+    const bool whole_file = text.substr(at, kFile.size()) == kFile;
+    if (!whole_file && text.substr(at, kLine.size()) != kLine) continue;
+    const size_t start = at + (whole_file ? kFile : kLine).size();
+    const std::string_view rest = text.substr(start);
+    found.push_back({static_cast<uint32_t>(start), rest.substr(0, rest.find_first_of(" \t#\r\n")), whole_file});
+  }
+  return found;
+}
+
 const char* severity_name(Severity s) {
   switch (s) {
     case Severity::Note: return "note";
@@ -49,19 +62,14 @@ const std::multimap<uint32_t, std::string_view>& DiagEngine::disable_comments(Fi
   const auto found = disable_comments_.find(file);
   if (found != disable_comments_.end()) return found->second;
   std::multimap<uint32_t, std::string_view>& lines = disable_comments_[file];
-  const std::string_view text = sources_.text(file);
-  auto rule_list = [&](size_t at) {
-    const std::string_view list = text.substr(at);
-    return list.substr(0, list.find_first_of(" \t#\r\n"));
-  };
-  static constexpr std::string_view kMarker = "kagec: disable=";
-  for (size_t at = text.find(kMarker); at != std::string_view::npos; at = text.find(kMarker, at + 1)) {
-    const uint32_t line = sources_.line_col(Loc{file, static_cast<uint32_t>(at)}).line;
-    if (!lines.count(line)) lines.emplace(line, rule_list(at + kMarker.size()));  // a line's first comment counts
+  for (const DisableComment& c : find_disable_comments(sources_.text(file))) {
+    if (c.whole_file) {
+      lines.emplace(kWholeFile, c.rules);
+      continue;
+    }
+    const uint32_t line = sources_.line_col(Loc{file, c.rules_offset}).line;
+    if (!lines.count(line)) lines.emplace(line, c.rules);  // a line's first comment counts
   }
-  static constexpr std::string_view kFileMarker = "kagec: disable-file=";
-  for (size_t at = text.find(kFileMarker); at != std::string_view::npos; at = text.find(kFileMarker, at + 1))
-    lines.emplace(kWholeFile, rule_list(at + kFileMarker.size()));
   return lines;
 }
 

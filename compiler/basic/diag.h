@@ -38,6 +38,16 @@ const RuleInfo& rule_info(Rule rule);
 /// The rule with this id (e.g. "yaml-syntax"), if any.
 const RuleInfo* find_rule(const std::string& id);
 
+/// A `kagec: disable=RULE[,RULE]` comment (its line and the next) or a `kagec: disable-file=RULE[,RULE]` one (its
+/// whole file), as written in a source text: the offset of its rule list and the list.
+struct DisableComment {
+  uint32_t rules_offset;
+  std::string_view rules;
+  bool whole_file;
+};
+/// Every disable comment of `text`, in order.
+std::vector<DisableComment> find_disable_comments(std::string_view text);
+
 /// A replacement suggested for a range of the source.
 struct FixIt {
   Range range;

@@ -527,6 +527,24 @@ bool single_document(const std::string& text, FileId file, DiagEngine& diags) {
   return true;
 }
 
+/// Reports each rule id of the file's disable comments that names no rule: such a comment silences nothing.
+void check_disable_comments(const std::string& text, FileId file, DiagEngine& diags) {
+  for (const DisableComment& c : find_disable_comments(text)) {
+    for (size_t start = 0; start <= c.rules.size();) {
+      const size_t comma = std::min(c.rules.find(',', start), c.rules.size());
+      const std::string id(c.rules.substr(start, comma - start));
+      if (!find_rule(id)) {
+        const uint32_t off = c.rules_offset + static_cast<uint32_t>(start);
+        diags.report(Rule::DisableUnknownRule, Range{Loc{file, off}, off + static_cast<uint32_t>(id.size())},
+                     (id.empty() ? std::string("an empty rule id") : "'" + id + "' is no rule") +
+                         ", so this comment silences nothing: name rules as `kagec rules` lists them, separated by "
+                         "commas without spaces");
+      }
+      start = comma + 1;
+    }
+  }
+}
+
 }  // namespace
 
 std::optional<DocNode> parse_yaml(const SourceManager& sources, FileId file, DiagEngine& diags) {
@@ -556,6 +574,7 @@ std::optional<DocNode> parse_yaml(const SourceManager& sources, FileId file, Dia
     return std::nullopt;
   }
   if (!single_document(text, file, diags)) return std::nullopt;
+  check_disable_comments(text, file, diags);
   Converter conv(sources, file, diags);
   DocNode doc = conv.convert(root, 0, "");
   return doc;
