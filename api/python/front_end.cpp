@@ -35,6 +35,14 @@ FrontEndResult resolve_config_json(const std::string& path, const std::string& a
   return {spec->canonical_text(), ""};
 }
 
+std::string lint_text(const std::string& path, const std::string& asset_root) {
+  SourceManager sources;
+  DiagEngine diags(sources);
+  DiskFileReader reader;
+  analyze_file(path, options_for(asset_root), sources, reader, diags);
+  return diagnostics_text(diags);
+}
+
 FrontEndResult certify_pair_json(const std::string& train, const std::string& eval, const std::string& asset_root) {
   SourceManager sources;
   DiagEngine diags(sources);

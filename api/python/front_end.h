@@ -18,6 +18,8 @@ struct FrontEndResult {
 
 /// The canonical Spec of a config (kagec resolve), with its "sha256" field.
 FrontEndResult resolve_config_json(const std::string& path, const std::string& asset_root);
+/// kagec lint's diagnostics of a config as text, warnings and errors alike; empty when it is clean.
+std::string lint_text(const std::string& path, const std::string& asset_root);
 /// The certificate of a train/eval pair (kagec diff --certify -o), verdict included.
 FrontEndResult certify_pair_json(const std::string& train, const std::string& eval, const std::string& asset_root);
 /// The certificate of a mixture (kagec diff --mixture -o): its configs, their Spec hashes and the visual axes

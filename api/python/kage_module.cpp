@@ -523,6 +523,9 @@ PYBIND11_MODULE(_kage, m) {
   m.def("resolve", [](const std::string& path, const std::string& asset_root) {
     return front_end_json(kage::python::resolve_config_json(path, asset_root));
   }, py::arg("path"), py::arg("asset_root") = "", "kagec resolve: the canonical Spec as JSON text.");
+  m.def("lint", [](const std::string& path, const std::string& asset_root) {
+    return text(kage::python::lint_text(path, asset_root));
+  }, py::arg("path"), py::arg("asset_root") = "", "kagec lint: the config's diagnostics as text ('' when clean).");
   m.def("certify", [](const std::string& train, const std::string& eval, const std::string& asset_root) {
     return front_end_json(kage::python::certify_pair_json(train, eval, asset_root));
   }, py::arg("train"), py::arg("eval"), py::arg("asset_root") = "",

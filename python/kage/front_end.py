@@ -1,7 +1,7 @@
-"""kagec's front end from Python: a config resolved to its Spec, a train/eval pair certified, a mixture
-certified, a suite's report. Each returns the JSON that ``kagec resolve``, ``kagec diff --certify``, ``kagec diff
---mixture`` and ``kagec suite`` print, parsed, and raises ``kage.ConfigError`` with kagec's located diagnostics
-when the input has errors."""
+"""kagec's front end from Python: a config linted or resolved to its Spec, a train/eval pair certified, a mixture
+certified, a suite's report. ``lint`` returns ``kagec lint``'s text; the others return the JSON that ``kagec
+resolve``, ``kagec diff --certify``, ``kagec diff --mixture`` and ``kagec suite`` print, parsed, and raise
+``kage.ConfigError`` with kagec's located diagnostics when the input has errors."""
 import json
 import os
 from typing import Optional, Sequence, Union
@@ -14,6 +14,12 @@ Path = Union[str, os.PathLike]
 def resolve(config: Path, asset_root: Optional[str] = None) -> dict:
     """The canonical Spec of ``config`` (``{"config": {...}, "sha256": ...}``, as ``kagec resolve``)."""
     return json.loads(native().resolve(os.fspath(config), asset_root or ""))
+
+
+def lint(config: Path, asset_root: Optional[str] = None) -> str:
+    """``kagec lint``'s diagnostics of ``config`` as text (warnings and errors, located, with their source
+    lines), or ``""`` when it is clean."""
+    return native().lint(os.fspath(config), asset_root or "")
 
 
 def certify(train: Path, eval: Path, asset_root: Optional[str] = None) -> dict:

@@ -7,6 +7,7 @@ import re
 import pytest
 
 from kage.bench import gpus, run
+from support import ROOT
 
 
 def dry(capsys, *extra):
@@ -87,3 +88,27 @@ def test_an_unknown_suite_is_named_with_the_shipped_ones(capsys, tmp_path, monke
     assert text.startswith("kage.bench run: suite 'suites/kage_bnch.yaml' is neither a path nor a shipped suite name")
     assert "near names: kage_bench" in text and "--out" not in text and ": ?:" not in text
     assert not (tmp_path / "never-made").exists()
+
+
+def test_a_suite_configs_warnings_are_shown_once_before_any_run(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    near_goal = ROOT / "tests/python/configs/near_goal.yaml"
+    (tmp_path / "inert.yaml").write_text(f"extends: {near_goal}\nbackground:\n  mode: black\n"
+                                         "  parallax_factor: 0.8\n")
+    (tmp_path / "suite.yaml").write_text(
+        "suite: tiny\ndescription: two pairs\npairs:\n" + "".join(
+            f"  - name: look/{i}\n    axis: background\n    description: a look\n    train: {near_goal}\n"
+            f"    eval: inert.yaml\n" for i in (1, 2)))
+    assert run.main([str(tmp_path / "suite.yaml"), "--seeds", "1", "--out", "never-made", "--dry-run"]) == 0
+    err = capsys.readouterr().err
+    assert err.count(f"kage.bench: warning: {tmp_path / 'inert.yaml'} has kagec's warnings") == 1  # once, two pairs
+    assert f"{tmp_path / 'inert.yaml'}:4:3: warning: 'background.parallax_factor' has no effect" in err
+    assert str(near_goal) + " has" not in err  # a clean config says nothing
+    assert not (tmp_path / "never-made").exists()
+
+
+def test_the_shipped_suite_has_no_config_warnings(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert run.main(["kage_bench", "--seeds", "1", "--out", "never-made", "--dry-run"]) == 0
+    captured = capsys.readouterr()
+    assert "kage.bench run --dry-run:" in captured.out and "warning" not in captured.err

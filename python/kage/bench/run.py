@@ -359,6 +359,7 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
         check_unit_name(unit.name)
     check_before_runs(probe, units)
     warn_unrun_configs(probe.num_envs, units)
+    warn_config_warnings(units)
     for p in report["pairs"]:
         if not p["certified"] and any(p["pair"] == q["pair"] for u in units for q in u.pairs):
             print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
@@ -401,6 +402,19 @@ def check_before_runs(probe, units) -> None:
         trainer = "kage.ppo.train: "  # the plug-ins' refusals name the trainer
         text = e.code[len(trainer):] if isinstance(e.code, str) and e.code.startswith(trainer) else e.code
         raise SystemExit(f"kage.bench: {text}\nkage.bench: no run started; fix the flag and run again") from None
+
+
+def warn_config_warnings(units) -> None:
+    """kagec's warnings of every config the units train or evaluate on, each config once, here rather than in the
+    runs' logs, where each run's trainer also writes them (kage.ConfigWarning)."""
+    configs: List[str] = []
+    for unit in units:
+        configs.extend(c for c in [*unit.train_configs, *unit.evals] if c not in configs)
+    for config in configs:
+        text = front_end.lint(config)
+        if text:
+            print(f"kage.bench: warning: {config} has kagec's warnings (silence a deliberate one with a "
+                  f"'# kagec: disable=RULE' comment):\n{text.rstrip()}", file=sys.stderr)
 
 
 def warn_unrun_configs(num_envs: int, units) -> None:
