@@ -3,7 +3,7 @@
 Outputs are views of the runtime's memory, not copies: numpy arrays on the CPU, ``kage.DeviceArray`` on
 the GPU (take them with ``torch.from_dlpack``, ``jax.dlpack.from_dlpack`` or ``cupy.asarray``). A view
 stays allocated while it exists, but its contents are overwritten by the next ``reset`` or ``step``:
-copy what you keep (``obs.copy()``, ``tensor.clone()``).
+copy what you keep (``obs.copy()``, ``tensor.clone()``), or make a CPU batch with ``copy=True``.
 """
 import contextlib
 import json
