@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <iterator>
 #include <set>
-#include <sstream>
 
 #include "api/environment.h"
 #include "compiler/analysis/mixture.h"
@@ -108,13 +107,6 @@ struct Loaded {
   std::string spec_hash;
   LoweredConfig config;
 };
-
-/// The text of `diags` (warnings alone where it holds no error), as kagec prints it.
-std::string diagnostics_text(const DiagEngine& diags) {
-  std::ostringstream s;
-  print_text(diags, s);
-  return s.str();
-}
 
 /// The asset loader's warnings, one a line, after `warnings`.
 void add_asset_warnings(const AssetPackResult& assets, const std::string& who, std::string* warnings) {

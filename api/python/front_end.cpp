@@ -1,8 +1,6 @@
 // The config compiler's front end for the Python package (see front_end.h).
 #include "api/python/front_end.h"
 
-#include <sstream>
-
 #include "compiler/analysis/diff.h"
 #include "compiler/analysis/mixture.h"
 #include "compiler/analysis/suite.h"
@@ -16,12 +14,6 @@ ResolveOptions options_for(const std::string& asset_root) {
   ResolveOptions o;
   if (!asset_root.empty()) o.asset_root = asset_root;
   return o;
-}
-
-std::string diagnostics_text(const DiagEngine& diags) {
-  std::ostringstream s;
-  print_text(diags, s);
-  return s.str();
 }
 
 }  // namespace

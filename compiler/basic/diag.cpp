@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 #include <ostream>
+#include <sstream>
 
 namespace kage {
 
@@ -24,17 +25,28 @@ const RuleInfo* find_rule(const std::string& id) {
   return nullptr;
 }
 
-std::vector<DisableComment> find_disable_comments(std::string_view text) {
-  std::vector<DisableComment> found;
+std::vector<DisabledRule> find_disabled_rules(std::string_view text) {
+  std::vector<DisabledRule> found;
   static constexpr std::string_view kLine = "kagec: disable=", kFile = "kagec: disable-file=";
   for (size_t at = text.find("kagec: disable"); at != std::string_view::npos; at = text.find("kagec: disable", at + 1)) {
     const bool whole_file = text.substr(at, kFile.size()) == kFile;
     if (!whole_file && text.substr(at, kLine.size()) != kLine) continue;
     const size_t start = at + (whole_file ? kFile : kLine).size();
     const std::string_view rest = text.substr(start);
-    found.push_back({static_cast<uint32_t>(start), rest.substr(0, rest.find_first_of(" \t#\r\n")), whole_file});
+    const std::string_view list = rest.substr(0, rest.find_first_of(" \t#\r\n"));
+    for (size_t item = 0; item <= list.size();) {  // comma-separated ids, empty ones included
+      const size_t comma = std::min(list.find(',', item), list.size());
+      found.push_back({static_cast<uint32_t>(start + item), list.substr(item, comma - item), whole_file});
+      item = comma + 1;
+    }
   }
   return found;
+}
+
+std::string diagnostics_text(const DiagEngine& engine) {
+  std::ostringstream s;
+  print_text(engine, s);
+  return s.str();
 }
 
 const char* severity_name(Severity s) {
@@ -62,14 +74,8 @@ const std::multimap<uint32_t, std::string_view>& DiagEngine::disable_comments(Fi
   const auto found = disable_comments_.find(file);
   if (found != disable_comments_.end()) return found->second;
   std::multimap<uint32_t, std::string_view>& lines = disable_comments_[file];
-  for (const DisableComment& c : find_disable_comments(sources_.text(file))) {
-    if (c.whole_file) {
-      lines.emplace(kWholeFile, c.rules);
-      continue;
-    }
-    const uint32_t line = sources_.line_col(Loc{file, c.rules_offset}).line;
-    if (!lines.count(line)) lines.emplace(line, c.rules);  // a line's first comment counts
-  }
+  for (const DisabledRule& d : find_disabled_rules(sources_.text(file)))
+    lines.emplace(d.whole_file ? kWholeFile : sources_.line_col(Loc{file, d.offset}).line, d.rule);
   return lines;
 }
 
@@ -82,18 +88,9 @@ bool DiagEngine::suppressed(const Diagnostic& d) const {
   if (!d.range.begin.valid()) return false;
   const std::multimap<uint32_t, std::string_view>& comments = disable_comments(d.range.begin.file);
   if (comments.empty()) return false;
-  auto lists = [&](std::string_view list) {
-    while (!list.empty()) {
-      const auto comma = list.find(',');
-      if (list.substr(0, comma) == id) return true;
-      if (comma == std::string_view::npos) break;
-      list.remove_prefix(comma + 1);
-    }
-    return false;
-  };
   auto mentions = [&](uint32_t line) {
     const auto [first, last] = comments.equal_range(line);
-    return std::any_of(first, last, [&](const auto& entry) { return lists(entry.second); });
+    return std::any_of(first, last, [&](const auto& entry) { return entry.second == id; });
   };
   const uint32_t line = sources_.line_col(d.range.begin).line;
   return mentions(kWholeFile) || mentions(line) || (line > 1 && mentions(line - 1));

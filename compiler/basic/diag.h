@@ -38,15 +38,16 @@ const RuleInfo& rule_info(Rule rule);
 /// The rule with this id (e.g. "yaml-syntax"), if any.
 const RuleInfo* find_rule(const std::string& id);
 
-/// A `kagec: disable=RULE[,RULE]` comment (its line and the next) or a `kagec: disable-file=RULE[,RULE]` one (its
-/// whole file), as written in a source text: the offset of its rule list and the list.
-struct DisableComment {
-  uint32_t rules_offset;
-  std::string_view rules;
+/// One rule id of a `kagec: disable=RULE[,RULE]` comment (its line and the next) or a
+/// `kagec: disable-file=RULE[,RULE]` one (its whole file), as written in a source text: its offset and the id
+/// (empty where the list has an empty item).
+struct DisabledRule {
+  uint32_t offset;
+  std::string_view rule;
   bool whole_file;
 };
-/// Every disable comment of `text`, in order.
-std::vector<DisableComment> find_disable_comments(std::string_view text);
+/// Every rule id of the disable comments of `text`, in order.
+std::vector<DisabledRule> find_disabled_rules(std::string_view text);
 
 /// A replacement suggested for a range of the source.
 struct FixIt {
@@ -91,8 +92,8 @@ class DiagEngine {
 
  private:
   bool suppressed(const Diagnostic& d) const;
-  /// The `kagec: disable=` lists of a file by line (1-based), and its `kagec: disable-file=` lists under
-  /// kWholeFile, found in one pass over its text.
+  /// The rules a file's `kagec: disable=` comments name, by line (1-based), and those of its
+  /// `kagec: disable-file=` comments under kWholeFile, found in one pass over its text.
   const std::multimap<uint32_t, std::string_view>& disable_comments(FileId file) const;
   static constexpr uint32_t kWholeFile = 0;
   const SourceManager& sources_;
@@ -112,6 +113,8 @@ inline constexpr size_t kMaxSnippetBytes = 160;
 /// characters are escaped (\0, \t, \x1b). After kMaxShownPerFile diagnostics of one file, a note
 /// says how many more errors and warnings it has.
 void print_text(const DiagEngine& engine, std::ostream& out, bool color = false);
+/// print_text's output (without colour) as a string.
+std::string diagnostics_text(const DiagEngine& engine);
 /// The frozen JSON form: {version, diagnostics: [...], summary}.
 void print_json(const DiagEngine& engine, std::ostream& out);
 

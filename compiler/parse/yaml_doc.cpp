@@ -529,19 +529,13 @@ bool single_document(const std::string& text, FileId file, DiagEngine& diags) {
 
 /// Reports each rule id of the file's disable comments that names no rule: such a comment silences nothing.
 void check_disable_comments(const std::string& text, FileId file, DiagEngine& diags) {
-  for (const DisableComment& c : find_disable_comments(text)) {
-    for (size_t start = 0; start <= c.rules.size();) {
-      const size_t comma = std::min(c.rules.find(',', start), c.rules.size());
-      const std::string id(c.rules.substr(start, comma - start));
-      if (!find_rule(id)) {
-        const uint32_t off = c.rules_offset + static_cast<uint32_t>(start);
-        diags.report(Rule::DisableUnknownRule, Range{Loc{file, off}, off + static_cast<uint32_t>(id.size())},
-                     (id.empty() ? std::string("an empty rule id") : "'" + id + "' is no rule") +
-                         ", so this comment silences nothing: name rules as `kagec rules` lists them, separated by "
-                         "commas without spaces");
-      }
-      start = comma + 1;
-    }
+  for (const DisabledRule& d : find_disabled_rules(text)) {
+    const std::string id(d.rule);
+    if (find_rule(id)) continue;
+    diags.report(Rule::DisableUnknownRule, Range{Loc{file, d.offset}, d.offset + static_cast<uint32_t>(id.size())},
+                 (id.empty() ? std::string("an empty rule id") : "'" + id + "' is no rule") +
+                     ", so this comment silences nothing: name rules as `kagec rules` lists them, separated by "
+                     "commas without spaces");
   }
 }
 
