@@ -171,8 +171,8 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                                      args.cuda_graph) if args.augment_mode == "rollout" else None
     env_step = streams.GraphedStep() if args.cuda_graph else None  # the rollout policy's actions keep their memory
 
+    clock = TrainClock()
     for iteration in range(start_iteration, last_iteration + 1):
-        iteration_start = time.perf_counter()
         for k, run in enumerate(runs):  # a schedule's stage boundary: the run's batches for the new mixture
             stage = schedule.stage_at(run.stages, iteration)
             if stage != run.stage:
@@ -285,15 +285,16 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
         measured = {**terms, "loss": loss, "explained_variance": explained_var, "var_returns": var_returns,
                     **state.stored_episodes(), "episode_sums": episode_sums}
         timer.end_iteration()
-        iteration_seconds = time.perf_counter() - iteration_start
+        host_values = to_host(measured)  # waits for the iteration's work on the device, which the clock then counts
+        iteration_seconds = clock.lap()
         state.train_seconds += iteration_seconds
         state.iteration = iteration
-        rows = train_rows(to_host(measured), iteration, state.global_step, state.train_seconds, iteration_seconds, args,
+        rows = train_rows(host_values, iteration, state.global_step, state.train_seconds, iteration_seconds, args,
                           optimizer.param_groups[0]["lr"], ent_coef)
         eval_rows = []
         if runs[0].eval_envs and (iteration % args.run_eval_every == 0 or iteration == last_iteration):
             progress.evaluating(iteration, len(runs[0].eval_envs), args.eval_episodes)
-            with timer("eval"):  # §2.5 step 6, and §3.1's final point
+            with timer("eval"), clock.paused():  # §2.5 step 6, and §3.1's final point
                 eval_rows = evaluation_point(agent, runs, boards, settings, args, iteration, state.global_step,
                                              train_rows=rows)
             progress.evaluated()
@@ -443,6 +444,30 @@ def check_memory(args: Args, runs: int, frame_shape, device) -> None:
         raise SystemExit(f"kage.ppo.train: the rollout's storage needs {needed / 2**30:.1f} GiB ({T} steps x {runs} "
                          f"run{'s' if runs > 1 else ''} x {N} environments of {'x'.join(map(str, frame_shape))} "
                          f"frames), and {where}: lower --num-envs or --num-steps, or pack fewer runs")
+
+
+class TrainClock:
+    """charts/SPS's clock (§4.3): the wall time of the training loop less its evaluation points (their videos
+    included). An iteration's lap runs from the last one's end to the host's read of this iteration's losses,
+    which waits for the device to finish its work; the logging and checkpoint after that read count in the next
+    lap, as in the original's running clock. Counting up to the read, not up to the last launch, keeps the
+    device's unfinished work in the figure: a CUDA host runs ahead of its device."""
+
+    def __init__(self):
+        self._mark = time.perf_counter()
+
+    def lap(self) -> float:
+        now = time.perf_counter()
+        seconds, self._mark = now - self._mark, now
+        return seconds
+
+    @contextlib.contextmanager
+    def paused(self):
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            self._mark += time.perf_counter() - start
 
 
 class NoTimer:
