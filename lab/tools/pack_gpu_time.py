@@ -2,8 +2,12 @@
 the runs one trainer process trained side by side on one GPU), the training seconds of its first run (the last
 iteration's global_step over its charts/SPS, which is the run's steps over its training time so far, resumes
 included) and its evaluation points' seconds (each point evaluates the whole pack at once, so every run of the pack
-logs the same seconds). Neither the start of a pack (kernels compiled, batches opened) nor its checkpoints count.
-The devices are those the packs' checksum lists name (`# device:` lines)."""
+logs the same seconds). The start of a pack (kernels compiled, batches opened) does not count. Packs trained before
+2086d34 count the host's time of each iteration only, not the device's unfinished work, the logging or the
+checkpoints (lab/2026-11-29-h200-train-clock); so each pack's wall time is given too: from its first run's run.json
+(written once the pack has opened) to its summary.json, as the files' times say (the packs' archives keep them), so
+that a pack resumed by a later process counts the time between. The devices are those the packs' checksum lists name
+(`# device:` lines)."""
 import glob
 import json
 import os
@@ -13,7 +17,7 @@ RUNS = "runs"
 
 
 def pack_seconds(root: str, pack_file: str) -> tuple:
-    """(training s, evaluation s) of one pack, from its first run's metrics.jsonl under `root`."""
+    """(training s, evaluation s, wall s) of one pack, from its first run's files under `root`."""
     with open(pack_file) as f:
         first = json.load(f)["runs"][0]["out"]
     # The pack file names the run by the path it trained in on the device: its runs/... tail is the same here.
@@ -28,15 +32,16 @@ def pack_seconds(root: str, pack_file: str) -> tuple:
                 evals += row["seconds"]
     if train is None:
         raise ValueError(f"{run}/metrics.jsonl has no training row")
-    return train["global_step"] / train["charts/SPS"], evals
+    wall = os.path.getmtime(os.path.join(run, "summary.json")) - os.path.getmtime(os.path.join(run, "run.json"))
+    return train["global_step"] / train["charts/SPS"], evals, wall
 
 
 def gpu_time(root: str) -> dict:
-    """{packs, train_hours, eval_hours} of the benchmark directory `root`."""
+    """{packs, train_hours, eval_hours, wall_hours} of the benchmark directory `root`."""
     packs = sorted(glob.glob(os.path.join(root, "packs", "task_*_pack_*.json")))
     seconds = [pack_seconds(root, p) for p in packs]
     return {"packs": len(packs), "train_hours": sum(s[0] for s in seconds) / 3600,
-            "eval_hours": sum(s[1] for s in seconds) / 3600}
+            "eval_hours": sum(s[1] for s in seconds) / 3600, "wall_hours": sum(s[2] for s in seconds) / 3600}
 
 
 def devices(packs: str) -> List[str]:

@@ -1,6 +1,7 @@
-"""lab/tools/pack_gpu_time.py: a method's GPU time from its runs' metrics, one run per pack, and its devices from
-the packs' checksum lists."""
+"""lab/tools/pack_gpu_time.py: a method's GPU time from its runs' metrics and files' times, one run per pack, and its
+devices from the packs' checksum lists."""
 import json
+import os
 import sys
 
 from support import ROOT
@@ -9,8 +10,12 @@ sys.path.insert(0, str(ROOT / "lab/tools"))
 import pack_gpu_time  # noqa: E402 (lab/tools is no package)
 
 
-def run_metrics(run, sps, eval_seconds):
+def run_files(run, sps, eval_seconds, wall):
+    """A run's metrics, and its run.json and summary.json `wall` seconds apart."""
     run.mkdir(parents=True)
+    for name, at in (("run.json", 1_000_000), ("summary.json", 1_000_000 + wall)):
+        (run / name).write_text("{}")
+        os.utime(run / name, (at, at))
     rows = [{"kind": "train", "iteration": 1, "global_step": 500, "charts/SPS": 1.0},  # a running mean: not summed
             {"kind": "train", "iteration": 2, "global_step": 1000, "charts/SPS": sps}]
     rows += [{"kind": "eval", "iteration": 2, "seconds": s} for s in eval_seconds]
@@ -25,13 +30,14 @@ def test_a_pack_counts_once_from_its_first_run(tmp_path):
     for name, runs in packs.items():
         (root / "packs" / name).write_text(json.dumps(
             {"runs": [{"out": f"/tmp/device-dir/{r}", "seed": 1} for r in runs]}))
-    run_metrics(root / "runs/a/seed_1", 10.0, [2.0, 3.0])  # 1000 / 10 = 100 s training, 5 s evaluation
-    run_metrics(root / "runs/a/seed_2", 1.0, [99.0])
-    run_metrics(root / "runs/b/seed_1", 4.0, [7.0])  # 250 s, 7 s
+    run_files(root / "runs/a/seed_1", 10.0, [2.0, 3.0], 120)  # 1000 / 10 = 100 s training, 5 s evaluation
+    run_files(root / "runs/a/seed_2", 1.0, [99.0], 999)
+    run_files(root / "runs/b/seed_1", 4.0, [7.0], 300)  # 250 s, 7 s
     time = pack_gpu_time.gpu_time(str(root))
     assert time["packs"] == 2
     assert abs(time["train_hours"] * 3600 - 350.0) < 1e-9
     assert abs(time["eval_hours"] * 3600 - 12.0) < 1e-9
+    assert abs(time["wall_hours"] * 3600 - 420.0) < 1e-9
 
 
 def test_devices_are_named_once_from_the_checksum_lists(tmp_path):

@@ -128,8 +128,10 @@ def test_the_tables_of_a_stand_in_method(tmp_path):
     packs = sum(1 for lines in lists for line in lines if re.search(r"  packs/task_\d+_pack_\d+\.json$", line))
     named = sorted({line[len("# device: "):] for lines in lists for line in lines if line.startswith("# device: ")})
     cost, baseline_cost = row(section(block, "GPU time"), "copy"), row(section(block, "GPU time"), "baseline")
-    assert cost[1] == str(packs) and cost[5] == "; ".join(named)
+    assert cost[1] == str(packs) and cost[6] == "; ".join(named)
     assert 0 < float(cost[2]) < float(baseline_cost[2]) and 0 < float(cost[3]) < float(baseline_cost[3])
+    # A pack's logged training and evaluation happen between its first run's run.json and summary.json.
+    assert float(cost[4]) <= float(cost[5]) < float(baseline_cost[5])
 
     again = tool("--methods-root", root, "--check")
     assert again.returncode == 0, again.stdout + again.stderr
