@@ -5,6 +5,7 @@ their checksums (table_unpack), each method is compared with the baseline on see
 
 - per axis: each method's IQM of eval success_once, its drop and P(method > baseline), each with its 95 % interval,
   under the baseline's row;
+- per pair of methods and axis: P(one method > the other), with its 95 % interval, from their own compare;
 - per method: the pairs and results it covers, its training runs' mean best train success, how many never passed
   0.1 and how many ended collapsed (kage.bench.training_runs);
 - per method: its GPU time from its runs' metrics (pack_gpu_time), the baseline's over all its seeds.
@@ -22,7 +23,7 @@ import difflib
 import os
 import sys
 import tempfile
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Tuple
 
 import generated_block  # beside this file, as table_unpack
 from pack_gpu_time import devices, gpu_time
@@ -61,8 +62,8 @@ def compared(dirs: List[str], names: List[str], out: str) -> dict:
     """compare.json of `kage.bench compare DIRS --names NAMES --seeds 1-5 --reps REPS --out OUT`."""
     try:
         return compare(dirs, names, out, reps=REPS, seeds=SEEDS)
-    except SystemExit as e:  # compare's refusal, naming the method it was comparing
-        fail(f"{names[0]} against the baseline: {e}")
+    except SystemExit as e:  # compare's refusal, naming the methods it was comparing
+        fail(f"{names[0]} against {names[1]}: {e}")
 
 
 def entry(result: dict, name: str) -> dict:
@@ -104,6 +105,13 @@ def axis_table(full: dict, results: Dict[str, dict]) -> str:
                      f"P(method > {BASELINE}) [95 % CI]"], table, 2)
 
 
+def head_to_head_table(matches: Dict[Tuple[str, str], dict]) -> str:
+    """Per pair of methods (A, B) and axis: the pairs both have and P(A > B) with its interval."""
+    rows = [[r["name"], a, b, r["n_pairs"], fmt_interval(r["p"])]
+            for (a, b), result in matches.items() for r in result["improvement"] if (r["x"], r["y"]) == (a, b)]
+    return md_table(["axis", "A", "B", "pairs", "P(A > B) [95 % CI]"], rows, 3)
+
+
 def training_table(full: dict, results: Dict[str, dict]) -> str:
     """Per method (the baseline first), the pairs and results it covers (its row over all pairs) and its training
     runs' outcomes."""
@@ -129,7 +137,8 @@ def cost_table(costs: Dict[str, tuple]) -> str:
                      "packs' wall GPU-hours", "devices"], rows, 1)
 
 
-def tables(full: dict, results: Dict[str, dict], costs: Dict[str, tuple]) -> str:
+def tables(full: dict, results: Dict[str, dict], matches: Dict[Tuple[str, str], dict],
+           costs: Dict[str, tuple]) -> str:
     """The generated part of the README."""
     estimates = entry(full, BASELINE)["estimates"]
     return (f"\n### Eval success per axis (seeds {SEEDS[0]}-{SEEDS[-1]})\n\n{axis_table(full, results)}\n"
@@ -138,6 +147,9 @@ def tables(full: dict, results: Dict[str, dict], costs: Dict[str, tuple]) -> str
             "method has a higher eval success than a run of the baseline (ties count half), averaged over the "
             "pairs; 0.5 is no difference. Each run's value is its maximum over training. "
             f"{explanation(estimates)}\n\n"
+            + (f"### Methods head to head (seeds {SEEDS[0]}-{SEEDS[-1]})\n\n{head_to_head_table(matches)}\n"
+               "P(A > B): as P(method > baseline) above, between two methods, on the pairs and seeds both have "
+               "(`kage.bench compare A_DIR B_DIR --names A B`).\n\n" if matches else "") +
             f"### Training runs (seeds {SEEDS[0]}-{SEEDS[-1]})\n\n{training_table(full, results)}\n"
             "Per training run (a run directory, however many pairs it is scored for): its maximum train success "
             "over the evaluation points, whether it stayed below 0.1, and whether it ended collapsed to the "
@@ -166,19 +178,24 @@ def computed(methods: List[str], methods_root: str, baseline_packs: str, work: s
     baseline_dir = os.path.join(work, BASELINE)
     unpack_all(baseline_packs, baseline_dir, say=lambda line: None)
     costs = {BASELINE: (gpu_time(baseline_dir), devices(baseline_packs))}
-    results = {}
-    for method in methods:
-        method_dir = os.path.join(work, "methods", method)
+    results, method_dirs = {}, {method: os.path.join(work, "methods", method) for method in methods}
+    for method, method_dir in method_dirs.items():
         unpack_all(os.path.join(methods_root, method, "packs"), method_dir, say=lambda line: None)
         costs[method] = (gpu_time(method_dir), devices(os.path.join(methods_root, method, "packs")))
         print(f"methods_tables: comparing {method} with the {BASELINE}", file=sys.stderr)
         results[method] = compared([method_dir, baseline_dir], [method, BASELINE],
                                    os.path.join(work, "compare", method))
+    matches = {}
+    for i, a in enumerate(methods):
+        for b in methods[i + 1:]:
+            print(f"methods_tables: comparing {a} with {b}", file=sys.stderr)
+            matches[(a, b)] = compared([method_dirs[a], method_dirs[b]], [a, b],
+                                       os.path.join(work, "compare", f"{a}-{b}"))
     full = next((r for r in results.values() if covers_all(r)), None)
     if full is None:  # no method has every pair and seed: the baseline's row comes from itself
         full = compared([baseline_dir, baseline_dir], [BASELINE, f"{BASELINE} again"],
                         os.path.join(work, "compare", BASELINE))
-    return tables(full, results, costs)
+    return tables(full, results, matches, costs)
 
 
 def main(argv: Optional[List[str]] = None) -> int:
@@ -190,7 +207,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser.add_argument("--baseline-packs", default=BASELINE_PACKS,
                         help="the baseline's packs (default results/kage-bench-table/packs)")
     parser.add_argument("--work", help="where to unpack and compare, kept afterwards (each method's compare.md is "
-                                       "in WORK/compare/METHOD); default: a temporary folder, removed")
+                                       "in WORK/compare/METHOD, each two methods' in WORK/compare/A-B); default: a temporary folder, removed")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 where the README's tables differ from those of the packs now")
     args = parser.parse_args(argv)

@@ -67,10 +67,14 @@ def test_the_readme_tables_are_those_of_the_packs_now():
         return
     assert row(block, "all pairs", "baseline")[2:4] == ["34", "170"]  # every pair, seeds 1-5
     for method in methods:
-        cells = row(block, "all pairs", method)
+        cells = row(section(block, "Eval success per axis"), "all pairs", method)
         assert int(cells[3]) > 0 and re.fullmatch(r"\d\.\d\d \[\d\.\d\d, \d\.\d\d\]", cells[6]), cells
         assert row(section(block, "Training runs"), method)[3] != "0", f"{method} has no training run in the tables"
         assert float(row(section(block, "GPU time"), method)[2]) > 0, f"{method} has no training time in the tables"
+    for i, a in enumerate(methods):  # every two methods head to head
+        for b in methods[i + 1:]:
+            cells = row(section(block, "Methods head to head"), "all pairs", a, b)
+            assert int(cells[3]) > 0 and re.fullmatch(r"\d\.\d\d \[\d\.\d\d, \d\.\d\d\]", cells[4]), cells
 
 
 # ---- the tool, on a stand-in method ----
@@ -119,6 +123,7 @@ def test_the_tables_of_a_stand_in_method(tmp_path):
         assert row(block, axis, "copy")[2:6] == row(block, axis, "baseline, on copy's results")[2:6]
     for axis in ("filters", "effects", "layout"):  # no stand-in run is scored there
         assert row(block, axis, "copy")[2:] == ["0", "0", "-", "-", "-"]
+    assert "### Methods head to head" not in block  # one method: no other to match it against
     # 2 run units x seeds 1-5; the baseline's 45 runs of seeds 1-5 include them
     training = section(block, "Training runs")
     assert row(training, "copy")[1:4] == [f"{len(pairs)} of 34", f"{5 * len(pairs)} of 170", "10"]
@@ -135,6 +140,22 @@ def test_the_tables_of_a_stand_in_method(tmp_path):
 
     again = tool("--methods-root", root, "--check")
     assert again.returncode == 0, again.stdout + again.stderr
+
+
+def test_two_methods_head_to_head(tmp_path):
+    """Two stand-ins with the same runs: where the one has a result, the other ties it, so P(one > other) is one
+    half on every axis they cover."""
+    root = stand_in(tmp_path)
+    shutil.copytree(root / "copy", root / "twin")
+    written = tool("--methods-root", root, "--work", tmp_path / "work")
+    assert written.returncode == 0, written.stderr
+    matches = section(block_of(root / "README.md"), "Methods head to head")
+    pairs = expected_pairs(tmp_path / "work/baseline")
+    assert row(matches, "all pairs", "copy", "twin")[3] == str(len(pairs))
+    for axis in ("background", "agent", "distractors", "all pairs"):
+        assert row(matches, axis, "copy", "twin")[4].startswith("0.50 ["), axis
+    for axis in ("filters", "effects", "layout"):  # neither has a result there
+        assert f"| {axis} |" not in matches
 
 
 def test_a_method_named_but_not_published_is_refused(tmp_path):
