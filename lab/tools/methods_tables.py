@@ -207,7 +207,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser.add_argument("--baseline-packs", default=BASELINE_PACKS,
                         help="the baseline's packs (default results/kage-bench-table/packs)")
     parser.add_argument("--work", help="where to unpack and compare, kept afterwards (each method's compare.md is "
-                                       "in WORK/compare/METHOD, each two methods' in WORK/compare/A-B); default: a temporary folder, removed")
+                                       "in WORK/compare/METHOD, each two methods' in WORK/compare/A-B); default: a "
+                                       "temporary folder, removed")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 where the README's tables differ from those of the packs now")
     args = parser.parse_args(argv)
