@@ -1,4 +1,4 @@
-"""kage.ppo.augment_plan's pass as Triton kernels: one program per frame and block of its elements, uint8 in
+"""kage.ppo.augment_plan's pass as Triton kernels: one program per frame and block of its pixels, uint8 in
 and out, the frame read where it lies (the rollout buffer, at a minibatch's indices) so that the gather and
 the augmentation are one pass. The stages are constexpr switches: a plan compiles to a kernel with only its
 own stages. kage.ppo.augment_plan.reference is the definition, and augment_plan.apply calls these with a
@@ -45,21 +45,49 @@ def _source(y, x, row, H: tl.constexpr, W: tl.constexpr, REMAP: tl.constexpr):
 
 
 @triton.jit
+def _finish(v, j, e, y, x, row, pictures_ptr, out, ok, H: tl.constexpr, W: tl.constexpr, NOISE: tl.constexpr,
+            OVERLAY: tl.constexpr, CUTOUT: tl.constexpr, NOISE_AT: tl.constexpr, OVERLAY_AT: tl.constexpr,
+            CUTOUT_AT: tl.constexpr):
+    """The per-channel stages of colour channel j (element indices e) from noise on, then the rounding and the
+    store."""
+    if NOISE:
+        sigma = tl.load(row + NOISE_AT)
+        key1 = tl.load(row + NOISE_AT + 1).to(tl.uint32)
+        key2 = tl.load(row + NOISE_AT + 2).to(tl.uint32)
+        index = e.to(tl.uint32)
+        u1 = _uniform(2 * index, key1, key2)
+        u2 = _uniform(2 * index + 1, key1, key2)
+        v += sigma * (tl.sqrt(-2.0 * tl.log(u1)) * tl.cos(6.283185307179586 * u2))
+    if OVERLAY:
+        picture = tl.load(row + OVERLAY_AT).to(tl.int64)
+        alpha = tl.load(row + OVERLAY_AT + 1)
+        p = tl.load(pictures_ptr + ((picture * H + y) * W + x) * 3 + j, mask=ok, other=0).to(tl.float32)
+        v = (1.0 - alpha) * v + alpha * p
+    if CUTOUT:
+        box = row + CUTOUT_AT
+        inside_box = (y >= tl.load(box + 0)) & (y < tl.load(box + 2)) & (x >= tl.load(box + 1)) & \
+            (x < tl.load(box + 3))
+        v = tl.where(inside_box, tl.load(box + 4 + j), v)
+    v = tl.minimum(tl.maximum(tl.floor(v + 0.5), 0.0), 255.0)
+    tl.store(out + e, v.to(tl.uint8), mask=ok)
+
+
+@triton.jit
 def plan_kernel(frames_ptr, images_ptr, rows_ptr, pictures_ptr, out_ptr,
                 H: tl.constexpr, W: tl.constexpr, C: tl.constexpr, ROW_WIDTH: tl.constexpr,
                 GATHER: tl.constexpr, REMAP: tl.constexpr, CONV: tl.constexpr, COLOUR: tl.constexpr,
                 NOISE: tl.constexpr, OVERLAY: tl.constexpr, CUTOUT: tl.constexpr,
                 CONV_AT: tl.constexpr, COLOUR_AT: tl.constexpr, NOISE_AT: tl.constexpr, OVERLAY_AT: tl.constexpr,
-                CUTOUT_AT: tl.constexpr, BLOCK_E: tl.constexpr):
-    """out[f] = the plan's stages on frame f (images[f] of the frames under GATHER), element e = (y, x, c) in
-    row-major order; each program one block of one frame's elements, stored contiguously."""
+                CUTOUT_AT: tl.constexpr, BLOCK_T: tl.constexpr):
+    """out[f] = the plan's stages on frame f (images[f] of the frames under GATHER). Each program works on one
+    block of one frame's pixel triplets t = (y, x, g), the three colour channels of pixel (y, x) of the stack's
+    frame g, elements 3 t + j in row-major order: the convolution and the colour map need all three channels of a
+    pixel, so a triplet computes them once for its three outputs."""
     f = tl.program_id(0).to(tl.int64)
-    e = tl.program_id(1) * BLOCK_E + tl.arange(0, BLOCK_E)
-    ok = e < H * W * C
-    pixel = e // C
-    c = e % C
-    j = c % 3
-    group = c - j
+    t = tl.program_id(1) * BLOCK_T + tl.arange(0, BLOCK_T)
+    ok = t < H * W * (C // 3)
+    pixel = t // (C // 3)
+    group = t % (C // 3) * 3
     y = pixel // W
     x = pixel % W
     if GATHER:
@@ -68,9 +96,9 @@ def plan_kernel(frames_ptr, images_ptr, rows_ptr, pictures_ptr, out_ptr,
         source_frame = f
     base = frames_ptr + source_frame * (H * W * C)
     row = rows_ptr + f * ROW_WIDTH
-    v0 = tl.zeros([BLOCK_E], dtype=tl.float32)
-    v1 = tl.zeros([BLOCK_E], dtype=tl.float32)
-    v2 = tl.zeros([BLOCK_E], dtype=tl.float32)
+    v0 = tl.zeros([BLOCK_T], dtype=tl.float32)
+    v1 = tl.zeros([BLOCK_T], dtype=tl.float32)
+    v2 = tl.zeros([BLOCK_T], dtype=tl.float32)
     if CONV:
         for dy in tl.static_range(3):
             for dx in tl.static_range(3):
@@ -97,28 +125,13 @@ def plan_kernel(frames_ptr, images_ptr, rows_ptr, pictures_ptr, out_ptr,
         r1 = tl.load(m + 3) * v0 + tl.load(m + 4) * v1 + tl.load(m + 5) * v2 + tl.load(m + 10)
         r2 = tl.load(m + 6) * v0 + tl.load(m + 7) * v1 + tl.load(m + 8) * v2 + tl.load(m + 11)
         v0, v1, v2 = r0, r1, r2
-    v = tl.where(j == 0, v0, tl.where(j == 1, v1, v2))
-    if NOISE:
-        sigma = tl.load(row + NOISE_AT)
-        key1 = tl.load(row + NOISE_AT + 1).to(tl.uint32)
-        key2 = tl.load(row + NOISE_AT + 2).to(tl.uint32)
-        index = e.to(tl.uint32)
-        u1 = _uniform(2 * index, key1, key2)
-        u2 = _uniform(2 * index + 1, key1, key2)
-        v += sigma * (tl.sqrt(-2.0 * tl.log(u1)) * tl.cos(6.283185307179586 * u2))
-    if OVERLAY:
-        picture = tl.load(row + OVERLAY_AT).to(tl.int64)
-        alpha = tl.load(row + OVERLAY_AT + 1)
-        p = tl.load(pictures_ptr + ((picture * H + y) * W + x) * 3 + j, mask=ok, other=0).to(tl.float32)
-        v = (1.0 - alpha) * v + alpha * p
-    if CUTOUT:
-        box = row + CUTOUT_AT
-        inside_box = (y >= tl.load(box + 0)) & (y < tl.load(box + 2)) & (x >= tl.load(box + 1)) & \
-            (x < tl.load(box + 3))
-        fill = tl.where(j == 0, tl.load(box + 4), tl.where(j == 1, tl.load(box + 5), tl.load(box + 6)))
-        v = tl.where(inside_box, fill, v)
-    v = tl.minimum(tl.maximum(tl.floor(v + 0.5), 0.0), 255.0)
-    tl.store(out_ptr + f * (H * W * C) + e, v.to(tl.uint8), mask=ok)
+    out = out_ptr + f * (H * W * C)
+    e = t * 3
+    _finish(v0, 0, e, y, x, row, pictures_ptr, out, ok, H, W, NOISE, OVERLAY, CUTOUT, NOISE_AT, OVERLAY_AT, CUTOUT_AT)
+    _finish(v1, 1, e + 1, y, x, row, pictures_ptr, out, ok, H, W, NOISE, OVERLAY, CUTOUT, NOISE_AT, OVERLAY_AT,
+            CUTOUT_AT)
+    _finish(v2, 2, e + 2, y, x, row, pictures_ptr, out, ok, H, W, NOISE, OVERLAY, CUTOUT, NOISE_AT, OVERLAY_AT,
+            CUTOUT_AT)
 
 
 @triton.jit
@@ -158,14 +171,14 @@ def apply(frames: torch.Tensor, rows: torch.Tensor, stages: Set[str], slots: Dic
     count = k * b
     out = torch.empty((k, b, h, w, c), dtype=torch.uint8, device=frames.device)
     if count:
-        plan_kernel[(count, triton.cdiv(h * w * c, BLOCK))](
+        plan_kernel[(count, triton.cdiv(h * w * c // 3, BLOCK))](
             frames, images.contiguous() if images is not None else rows, rows,
             pictures if pictures is not None else rows, out,
             H=h, W=w, C=c, ROW_WIDTH=rows.shape[1], GATHER=images is not None,
             REMAP="remap" in stages, CONV="conv" in stages, COLOUR="colour" in stages, NOISE="noise" in stages,
             OVERLAY="overlay" in stages, CUTOUT="cutout" in stages,
             CONV_AT=slots["conv"][0], COLOUR_AT=slots["colour"][0], NOISE_AT=slots["noise"][0],
-            OVERLAY_AT=slots["overlay"][0], CUTOUT_AT=slots["cutout"][0], BLOCK_E=BLOCK, num_warps=4)
+            OVERLAY_AT=slots["overlay"][0], CUTOUT_AT=slots["cutout"][0], BLOCK_T=BLOCK, num_warps=4)
     return out
 
 
