@@ -33,7 +33,8 @@ def plan_of(stages, count, device):
         plan.colour = torch.cat([torch.randn((count, 9), generator=g) * 0.2 + torch.eye(3).reshape(9),
                                  torch.rand((count, 3), generator=g) * 40 - 20], 1)
     if "noise" in stages:
-        plan.noise = torch.cat([torch.full((count, 1), 8.0), torch.floor(torch.rand((count, 2), generator=g) * (1 << 24))], 1)
+        keys = torch.floor(torch.rand((count, 2), generator=g) * (1 << 24))
+        plan.noise = torch.cat([torch.full((count, 1), 8.0), keys], 1)
     if "overlay" in stages:
         plan.overlay = torch.stack([torch.randint(0, 4, (count,), generator=g).float(),
                                     torch.rand((count,), generator=g) * 0.5], 1)
@@ -67,7 +68,8 @@ def main():
     for k in map(int, sys.argv[2:]):
         buffer = torch.randint(0, 256, (k * 16384, 128, 128, 3), dtype=torch.uint8, device=device)
         images = (torch.randint(0, 16384, (k, 2048), device=device) + 16384 * torch.arange(k, device=device)[:, None])
-        for stages in (["conv"], ["colour"], ["noise"], ["overlay"], ["remap"], ["cutout"], ["remap", "conv", "colour"]):
+        for stages in (["conv"], ["colour"], ["noise"], ["overlay"], ["remap"], ["cutout"],
+                       ["remap", "conv", "colour"]):
             plan = plan_of(stages, images.numel(), device)
             rows = plan.rows(images.numel(), device).to(device)
             run = lambda module: module.apply(buffer, rows, set(plan.stages()), augment_plan.SLOTS,  # noqa: E731
