@@ -4,7 +4,7 @@ on the device: for each plan of the standard augmentations' stages, both version
 update's minibatches are), the bytes that differ are counted, and each version is timed with CUDA events (median
 of 20 launches after 3). usage: python3 kernel_speed.py OTHER_MODULE.py K [K ...]"""
 import importlib.util
-import statistics
+import os
 import sys
 
 import torch
@@ -12,6 +12,9 @@ import torch
 from kage.ppo import augment_plan
 from kage.ppo.augment_plan import Plan
 from kage.ppo.fast import augment_kernel
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
+from cuda_timing import median_ms  # noqa: E402  (lab/tools, the device scripts' timing)
 
 
 def load(path: str):
@@ -45,20 +48,6 @@ def plan_of(stages, count, device):
     return plan
 
 
-def timed(fn):
-    for _ in range(3):
-        fn()
-    times = []
-    for _ in range(20):
-        start, end = torch.cuda.Event(enable_timing=True), torch.cuda.Event(enable_timing=True)
-        start.record()
-        fn()
-        end.record()
-        torch.cuda.synchronize()
-        times.append(start.elapsed_time(end))
-    return statistics.median(times)
-
-
 def main():
     other = load(sys.argv[1])
     device = torch.device("cuda")
@@ -75,7 +64,8 @@ def main():
             run = lambda module: module.apply(buffer, rows, set(plan.stages()), augment_plan.SLOTS,  # noqa: E731
                                               plan.images, images)
             differing = int((run(other) != run(augment_kernel)).sum())
-            before, after = timed(lambda: run(other)), timed(lambda: run(augment_kernel))
+            before = median_ms(lambda: run(other), repeats=20)
+            after = median_ms(lambda: run(augment_kernel), repeats=20)
             print(f"| {k} | {'+'.join(stages)} | {images.numel()} | {before:.2f} | {after:.2f} | "
                   f"{before / after:.2f} | {differing} |", flush=True)
         del buffer
