@@ -9,6 +9,7 @@ import pytest
 from test_report import PNG_SIGNATURE, SUITE, bench, by_name, pair, plain, write_run  # noqa: F401 (bench: fixture)
 
 from kage.bench import intervals, report
+from kage.bench.interval_tables import fmt_drop
 
 SIDE_METRICS = ("return", "length", "passed_distance", "progress", "jump_count", "success", "success_once")
 DIFFS = ("return", "success", "progress", "success_once", "passed_distance", "jump_count")
@@ -174,3 +175,11 @@ def test_metric_progress(tmp_path):
     assert final["out_dir"] == str(tmp_path / "report_final_progress_interim")
     with pytest.raises(SystemExit, match="take success_once, success, progress, not 'passed_distance'"):
         report.report(str(tmp_path), reps=100, metric="passed_distance")
+
+
+def test_drop_without_interval_names_its_share_of_resamples():
+    # The interval is dropped when a resample's train mean is 0; a share rounding to 0.0 % must not read as none.
+    rare = {"point": 14.2, "low": None, "high": None, "undefined_fraction": 3 / 50_000}
+    common = {"point": 14.2, "low": None, "high": None, "undefined_fraction": 0.25}
+    assert fmt_drop(rare) == "14.2 % [n/a: train 0 in < 0.1 % of resamples]"
+    assert fmt_drop(common) == "14.2 % [n/a: train 0 in 25.0 % of resamples]"

@@ -23,7 +23,10 @@ def fmt_drop(drop: Optional[dict]) -> str:
     if drop["point"] is None:
         return "n/a"
     if drop["low"] is None:
-        return f"{drop['point']:.1f} % [n/a: train 0 in {100 * drop['undefined_fraction']:.1f} % of resamples]"
+        share = 100 * drop["undefined_fraction"]
+        # A few resamples in 50,000 are under 0.1 %: "0.0 %" would read as none.
+        shown = f"{share:.1f} %" if share >= 0.1 else "< 0.1 %"
+        return f"{drop['point']:.1f} % [n/a: train 0 in {shown} of resamples]"
     return f"{drop['point']:.1f} % [{drop['low']:.1f}, {drop['high']:.1f}]"
 
 
