@@ -1,9 +1,13 @@
 """Unpacks the packed tasks of the whole KAGE-Bench table (results/kage-bench-table/packs, written by
 lab/tools/pack_task.py) into one benchmark directory for `kage.bench report` and `kage.bench compare`. Each
 archive's checksum is checked before it is opened, and each unpacked file's after; a mismatch stops with the
-file's name. A checksum list's `#` lines (its provenance) are skipped, as `sha256sum -c` skips them.
+file's name. A checksum list's `#` lines (its provenance) are skipped, as `sha256sum -c` skips them. The archives
+must come from one benchmark (one `kage.bench run` layout: pairs, seeds, --pack, trainer flags): an archive whose
+files would replace different ones already unpacked stops with both names, since report and compare read the
+benchmark's runs from its bench.json and would silently lose those of the other layout.
 
 usage: python3 lab/tools/table_unpack.py PACKS DIR"""
+import json
 import os
 import sys
 import tarfile
@@ -25,6 +29,31 @@ def read_sums(path: str) -> list:
     return sums
 
 
+# Where the benchmark's files may differ between archives of one benchmark: the path each runner was started with.
+SAME_BUT = {"bench.json": lambda d: {k: v for k, v in d.items() if k != "suite"},
+            "suite.json": lambda d: [(p["pair"], p["train"]["spec_sha256"], p["eval"]["spec_sha256"])
+                                     for p in d.get("pairs", [])]}
+
+
+def check_no_replacement(tar: tarfile.TarFile, archive: str, dest: str) -> None:
+    """Stops where a file of `archive` would replace a different one that an archive unpacked before left in `dest`."""
+    for member in tar.getmembers():
+        path = os.path.join(dest, member.name)
+        if not member.isfile() or not os.path.exists(path):
+            continue
+        data = tar.extractfile(member).read()
+        with open(path, "rb") as f:
+            before = f.read()
+        if member.name in SAME_BUT:
+            same = SAME_BUT[member.name](json.loads(data)) == SAME_BUT[member.name](json.loads(before))
+        else:
+            same = data == before
+        if not same:
+            sys.exit(f"table_unpack: {archive}: its {member.name} differs from {path}, unpacked before it: the "
+                     "archives come from different benchmarks (another --pairs, --seeds, --pack or trainer flags); "
+                     "unpack each benchmark's archives into a folder of its own")
+
+
 def unpack(packs: str, archive_name: str, dest: str) -> int:
     archive = os.path.join(packs, archive_name)
     sums_path = archive[:-len(".tar.gz")] + ".sha256"
@@ -35,6 +64,7 @@ def unpack(packs: str, archive_name: str, dest: str) -> int:
         sys.exit(f"table_unpack: {archive}: its sha256 is not the one in {sums_path}:{number}; the archive is "
                  "damaged")
     with tarfile.open(archive) as tar:
+        check_no_replacement(tar, archive, dest)
         tar.extractall(dest, filter="data")
     for number, digest, name in files:
         if sha256(os.path.join(dest, name)) != digest:

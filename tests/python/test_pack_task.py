@@ -130,3 +130,33 @@ def test_new_bundles_what_passes_the_file_limit_in_one_file(tmp_path):
     assert_unpacks_to_the_runs(tmp_path / "packs", tmp_path / "home", root)
     assert pack_new(root, tmp_path / "next_call", 4).returncode == 0  # nothing left to pack
     assert not (tmp_path / "next_call").exists() or not list((tmp_path / "next_call").iterdir())
+
+
+def test_unpack_refuses_the_archives_of_two_benchmarks_in_one_folder(tmp_path):
+    """Archives whose bench.json differ beyond the path each runner started from come from two benchmarks (another
+    --pairs, --seeds, --pack or trainer flags): unpacked into one folder, report and compare would read one's runs."""
+    roots = {}
+    every = ["a/1", "b/1", "c/1"]
+    for name, suite, units in (("first", "/a/s.yaml", every), ("moved", "/b/s.yaml", every),
+                               ("other", "/a/s.yaml", ["c/1"])):
+        roots[name] = benchmark(tmp_path / name)
+        (roots[name] / "bench.json").write_text(json.dumps({"suite": suite, "units": units}))
+        assert pack_new(roots[name], tmp_path / f"out_{name}", 8).returncode == 0
+    packs = tmp_path / "packs"
+    packs.mkdir()
+
+    def publish(task, name):
+        for suffix in (".tar.gz", ".sha256"):
+            (tmp_path / f"out_{name}" / f"{task}{suffix}").replace(packs / f"{task}{suffix}")
+
+    publish("task_0", "first")
+    publish("task_1", "moved")  # the same benchmark, its runner started from another path: unpacks as one
+    publish("task_2", "moved")
+    assert_unpacks_to_the_runs(packs, tmp_path / "home", roots["first"])
+
+    publish("task_2", "other")
+    result = subprocess.run([sys.executable, str(UNPACK), str(packs), str(tmp_path / "home2")],
+                            capture_output=True, text=True)
+    assert result.returncode == 1
+    assert f"{packs / 'task_2.tar.gz'}: its bench.json differs from {tmp_path / 'home2/bench.json'}" in result.stderr
+    assert "unpack each benchmark's archives into a folder of its own" in result.stderr
