@@ -9,6 +9,7 @@ benchmark's runs from its bench.json and would silently lose those of the other 
 usage: python3 lab/tools/table_unpack.py PACKS DIR"""
 import json
 import os
+import re
 import sys
 import tarfile
 
@@ -75,8 +76,12 @@ def unpack(packs: str, archive_name: str, dest: str) -> int:
 
 def unpack_all(packs: str, dest: str, say=print) -> int:
     """Unpacks every task_I.tar.gz of `packs` into `dest`, in task order, each checked; the number of tasks."""
-    names = sorted((n for n in os.listdir(packs) if n.endswith(".tar.gz")),
-                   key=lambda n: int(n[len("task_"):-len(".tar.gz")]))
+    names = [n for n in os.listdir(packs) if n.endswith(".tar.gz")]
+    for name in names:
+        if not re.fullmatch(r"task_\d+\.tar\.gz", name):
+            sys.exit(f"table_unpack: {os.path.join(packs, name)}: not a task archive (task_I.tar.gz, as pack_task.py "
+                     "names them): rename it to its task's name, with its checksum list, or move it out of the folder")
+    names.sort(key=lambda n: int(n[len("task_"):-len(".tar.gz")]))
     if not names:
         sys.exit(f"table_unpack: {packs}: no task_I.tar.gz archives")
     os.makedirs(dest, exist_ok=True)

@@ -160,3 +160,14 @@ def test_unpack_refuses_the_archives_of_two_benchmarks_in_one_folder(tmp_path):
     assert result.returncode == 1
     assert f"{packs / 'task_2.tar.gz'}: its bench.json differs from {tmp_path / 'home2/bench.json'}" in result.stderr
     assert "unpack each benchmark's archives into a folder of its own" in result.stderr
+
+
+def test_unpack_names_an_archive_that_is_not_a_task_s(tmp_path):
+    root = benchmark(tmp_path / "bench")
+    packs = tmp_path / "packs"
+    assert pack_new(root, packs, 8).returncode == 0
+    (packs / "task_1.tar.gz").rename(packs / "task_1 (copy).tar.gz")  # as a browser names a second download
+    result = subprocess.run([sys.executable, str(UNPACK), str(packs), str(tmp_path / "home")],
+                            capture_output=True, text=True)
+    assert result.returncode == 1
+    assert f"{packs / 'task_1 (copy).tar.gz'}: not a task archive (task_I.tar.gz" in result.stderr
