@@ -74,14 +74,17 @@ def unpack(packs: str, archive_name: str, dest: str) -> int:
     return len(files)
 
 
+TASK_ARCHIVE = re.compile(r"task_(\d+)\.tar\.gz")  # pack_task.py's name for task I's archive
+
+
 def unpack_all(packs: str, dest: str, say=print) -> int:
     """Unpacks every task_I.tar.gz of `packs` into `dest`, in task order, each checked; the number of tasks."""
     names = [n for n in os.listdir(packs) if n.endswith(".tar.gz")]
     for name in names:
-        if not re.fullmatch(r"task_\d+\.tar\.gz", name):
+        if not TASK_ARCHIVE.fullmatch(name):
             sys.exit(f"table_unpack: {os.path.join(packs, name)}: not a task archive (task_I.tar.gz, as pack_task.py "
                      "names them): rename it to its task's name, with its checksum list, or move it out of the folder")
-    names.sort(key=lambda n: int(n[len("task_"):-len(".tar.gz")]))
+    names.sort(key=lambda n: int(TASK_ARCHIVE.fullmatch(n)[1]))
     if not names:
         sys.exit(f"table_unpack: {packs}: no task_I.tar.gz archives")
     os.makedirs(dest, exist_ok=True)
