@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from kage.bench import gpus, run
+from kage.bench import gpus, run, tasks
 from support import ROOT, TINY_TRAINING
 
 PAIRS = ["background/1", "agent_appearance/1", "distractors/1"]
@@ -107,12 +107,44 @@ def test_the_eta_counts_the_workers_in_parallel():
     """As when the first of four parallel tasks ends: 600 s a task (weight 60 at 10 s a unit), three of four GPUs
     still busy (590, 580 and 100 s in), six tasks waiting. By hand: the GPUs come free at 0, 10, 20 and 500 s; the
     six waiting tasks take them in that order and then at 600 and 610 s, so the last ends at 610 + 600 = 1,210 s."""
-    assert gpus.eta_seconds(10, [60] * 6, [(60, 590), (60, 580), (60, 100)], 4) == 1210
-    assert gpus.eta_seconds(10, [], [(60, 100)], 4) == 500  # only the running task's rest
+    assert gpus.eta_seconds(10, [60] * 6, [(60, 590, 0, 0), (60, 580, 0, 0), (60, 100, 0, 0)], 4) == 1210
+    assert gpus.eta_seconds(10, [], [(60, 100, 0, 0)], 4) == 500  # only the running task's rest
     assert gpus.eta_seconds(100, [1, 1, 1], [], 1) == 300  # one GPU: one task after another
     # Tasks of other weights, handed out longest first to 2 GPUs at 1 s a unit: 50 and 40 start at 0; 30 takes
     # the GPU free at 40 (ends 70); 20 the one free at 50 (ends 70); 10 the one free at 70: the last ends at 80.
     assert gpus.eta_seconds(1, [50, 40, 30, 20, 10], [], 2) == 80
+
+
+def test_a_running_task_ends_at_its_own_rate_once_it_has_one():
+    """A running task's rest comes from its runs' progress once they have trained MEASURED_PROGRESS of it in this
+    process: as in a 4-GPU lease, where the weights put a 7-config task's end 6 minutes away when it ended in one."""
+    # 95 % of the task in 925 s: the last 5 % at the same rate takes 925 * 0.05 / 0.95 = 48.68 s, whatever its weight
+    assert gpus.running_rest(15.4, 85, 925, 0.0, 0.95) == pytest.approx(48.68, abs=0.01)
+    # resumed at half its training, three quarters now after 300 s: the last quarter takes 300 s more
+    assert gpus.running_rest(15.4, 85, 300, 0.5, 0.75) == pytest.approx(300)
+    # too little done in this process to say (the start, the first iterations): the weight's estimate
+    assert gpus.running_rest(10, 60, 100, 0.5, 0.51) == 500
+    assert gpus.running_rest(10, 60, 700, 0.0, 0.0) == 0  # past its weight's time and nothing known: no rest
+    # the parallel case above with measured tasks: ends at 48.7, 300 and 500 s; two waiting tasks of 60 (600 s)
+    # take the free GPU at 0 and the one free at 48.7: the last ends at 648.7
+    running = [(85, 925, 0.0, 0.95), (85, 300, 0.5, 0.75), (60, 100, 0.0, 0.0)]
+    assert gpus.eta_seconds(10, [60, 60], running, 4) == pytest.approx(648.68, abs=0.01)
+
+
+def test_task_progress_reads_the_runs_metrics(tmp_path):
+    """A task's share done: a finished run (summary.json) counts whole, a running one its last training row's
+    global_step (a last row cut off mid-write skipped), a run not started yet none."""
+    runs = [tmp_path / name for name in ("finished", "running", "waiting")]
+    runs[0].mkdir()
+    (runs[0] / "summary.json").write_text("{}")
+    runs[1].mkdir()
+    rows = [{"kind": "train", "global_step": 250, "charts/SPS": 5.0}, {"kind": "eval", "global_step": 300},
+            {"kind": "train", "global_step": 300, "charts/SPS": 6.0}]
+    (runs[1] / "metrics.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows) + '{"kind": "tra')
+    task = [(None, seed, str(run)) for seed, run in enumerate(runs)]
+    assert tasks.last_progress(str(runs[1] / "metrics.jsonl")) == (300, 6.0)
+    assert tasks.last_progress(str(runs[2] / "metrics.jsonl")) == (0, None)
+    assert tasks.task_progress(task, 1000) == pytest.approx((1000 + 300 + 0) / 3000)
 
 
 def test_tasks_are_handed_out_longest_first():

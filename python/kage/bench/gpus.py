@@ -2,7 +2,9 @@
 GPU takes the longest unfinished task left (task_weight: its runs times the configs each evaluates, plus its
 training), so that the GPUs finish together, and trains it in a child process
 (`kage.bench run ... --task I`, its log in DIR/tasks/task_<I>.log) that sees that GPU alone, until no task
-is left: the same tasks as a Slurm array, resumable the same way, one report.
+is left: the same tasks as a Slurm array, resumable the same way, one report. As each task ends it prints the
+tasks left and an ETA: the running tasks' ends at the rates their runs have trained at (their metrics.jsonl), the
+waiting tasks' by weight at the seconds per unit of weight the finished ones took.
 
 KAGE_BENCH_FAKE_GPUS=N stands for N GPUs that do not exist, for testing the scheduler on a machine without
 one (with --device cpu): `all` means 0..N-1 and each worker's CUDA_VISIBLE_DEVICES names its fake device."""
@@ -81,11 +83,26 @@ def hand_out(durations: List[float], free_at: List[float]) -> Tuple[List[List[in
     return taken, ends
 
 
+# The share of its training a running task must have done in this process before its own rate, rather than its
+# weight, says when it ends: past its start (the kernels compiled, the batches opened) and its first iterations.
+MEASURED_PROGRESS = 0.02
+
+
+def running_rest(unit_seconds: float, weight: int, elapsed: float, done_before: float, done_now: float) -> float:
+    """Seconds left of a running task: at the rate its runs have trained at so far in this process (from done_before
+    to done_now, shares of its training, in `elapsed` seconds), or, before that says much, as its weight says.
+    The weights' estimate errs by whole minutes where the pack size or the method changes what a run costs."""
+    gained = done_now - done_before
+    if gained >= MEASURED_PROGRESS:
+        return elapsed * (1.0 - done_now) / gained
+    return max(weight * unit_seconds - elapsed, 0.0)
+
+
 def eta_seconds(unit_seconds: float, waiting: List[int], running: List[tuple], workers: int) -> float:
-    """Seconds until the last task ends if a task of weight w takes w * unit_seconds: the running tasks ((weight,
-    seconds elapsed) each) end first, and the workers take the waiting tasks (their weights, in the order they are
-    handed out) as they come free."""
-    free = [max(weight * unit_seconds - elapsed, 0.0) for weight, elapsed in running]
+    """Seconds until the last task ends if a waiting task of weight w takes w * unit_seconds: the running tasks
+    ((weight, seconds elapsed, share done when it began, share done now) each, running_rest) end first, and the
+    workers take the waiting tasks (their weights, in the order they are handed out) as they come free."""
+    free = [running_rest(unit_seconds, *task) for task in running]
     free += [0.0] * (workers - len(free))
     return max(hand_out([weight * unit_seconds for weight in waiting], free)[1])
 
@@ -125,7 +142,7 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: O
     children = {}
     failed: List[int] = []
     stopping = threading.Event()
-    began = {}  # device -> (its task's weight, when it began)
+    began = {}  # device -> (its task's index, weight, when it began, share of its training done then)
     finished_time, finished_weight = [0.0], [0]  # of tasks trained to the end: a stopped task says nothing
 
     def worker(device: str) -> None:
@@ -136,7 +153,8 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: O
                 index = todo.pop(0)
                 print(f"[gpu {device}] task {index}: {tasks.describe(table[index])}", file=sys.stderr, flush=True)
                 log = open(os.path.join(log_dir, f"task_{index}.log"), "ab")
-                began[device] = (task_weight(table[index]), time.monotonic())
+                began[device] = (index, task_weight(table[index]), time.monotonic(),
+                                 tasks.task_progress(table[index], bench.steps_per_run))
                 children[device] = subprocess.Popen([*bench.run_command(), "--task", str(index)], stdout=log,
                                                     stderr=log, env=child_environment(CUDA_VISIBLE_DEVICES=device))
             code = children[device].wait()
@@ -144,11 +162,13 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: O
             with lock:
                 now = time.monotonic()
                 if code == 0:
-                    finished_time[0] += now - began[device][1]
-                    finished_weight[0] += began[device][0]
+                    finished_time[0] += now - began[device][2]
+                    finished_weight[0] += began[device][1]
                 if code != 0 and not stopping.is_set():
                     failed.append(index)
-                running = [(began[d][0], now - began[d][1]) for d, child in children.items() if child.poll() is None]
+                running = [(weight, now - start, done_before, tasks.task_progress(table[task], bench.steps_per_run))
+                           for d, (task, weight, start, done_before) in began.items()
+                           if children[d].poll() is None]
                 left = len(todo) + len(running)
                 eta = ""
                 if finished_weight[0] and not stopping.is_set():

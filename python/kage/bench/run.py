@@ -45,8 +45,7 @@ from kage.bench import dry_run, gpus, run_state, tasks
 from kage.bench.records import bench_problem, parse_seeds, suite_problem, unit_name_problem
 from kage.bench.units import Unit, select, train_stem, training_configs, units_of
 from kage.errors import ConfigError
-from kage.util.files import (LOG_LIMIT, atomic_write, open_regular, os_error_text, read_json_record, read_regular,
-                             remove_strays, write_json)
+from kage.util.files import atomic_write, os_error_text, read_json_record, read_regular, remove_strays, write_json
 from kage.util.lock import DirectoryLock, LockHeld
 from kage.util.stop import child_environment, die_with_parent, stop_children
 
@@ -244,7 +243,7 @@ class Display:
 
     def running(self, label: str, metrics_path: str, runs: int) -> None:
         """`runs` runs in one process, `metrics_path` the log of one of them."""
-        step, rate = last_progress(metrics_path)
+        step, rate = tasks.last_progress(metrics_path)
         self.rate = rate * runs if rate else self.rate
         remaining = (self.total - self.done) * self.steps_per_run - step * runs
         eta = f"ETA {remaining / self.rate / 60:,.0f} min" if self.rate else "ETA -"
@@ -257,25 +256,6 @@ class Display:
         self.done += 1
         prefix = "\r\033[K" if self.live else ""
         print(f"{prefix}[{self.done}/{self.total}] {label}: {status}", file=sys.stderr, flush=True)
-
-
-def last_progress(metrics_path: str):
-    """The global step and steps/s of a run's last training row (0, None before the first)."""
-    try:
-        with open_regular(metrics_path, LOG_LIMIT) as f:
-            f.seek(max(0, os.fstat(f.fileno()).st_size - 65536))
-            lines = f.read(65536).decode(errors="replace").splitlines()
-    except OSError:
-        return 0, None
-    for line in reversed(lines):
-        try:
-            row = json.loads(line)
-        except (ValueError, RecursionError):
-            continue
-        if isinstance(row, dict) and row.get("kind") == "train" and \
-                all(isinstance(row.get(k), (int, float)) for k in ("global_step", "charts/SPS")):
-            return row["global_step"], row["charts/SPS"]
-    return 0, None
 
 
 class Stop(Exception):

@@ -2,10 +2,11 @@
 (--pack K) that one process trains together. A task index names the same runs wherever it is decoded (a
 Slurm array task, a GPU worker, `kage.bench run --task I`): the table is a pure function of the units, the
 seeds and K, and DIR/tasks.json records it for `kage.bench status`."""
+import json
 import os
 from typing import Dict, List, Sequence, Tuple
 
-from kage.util.files import write_json
+from kage.util.files import LOG_LIMIT, open_regular, write_json
 
 Job = Tuple[object, int, str]  # (units.Unit, seed, run directory)
 
@@ -35,3 +36,30 @@ def write_task_table(out: str, table: List[List[Job]], pack: int) -> None:
 
 def is_finished(job: Job) -> bool:
     return os.path.exists(os.path.join(job[2], "summary.json"))
+
+
+def last_progress(metrics_path: str):
+    """The global step and steps/s of a run's last training row (0, None before the first)."""
+    try:
+        with open_regular(metrics_path, LOG_LIMIT) as f:
+            f.seek(max(0, os.fstat(f.fileno()).st_size - 65536))
+            lines = f.read(65536).decode(errors="replace").splitlines()
+    except OSError:
+        return 0, None
+    for line in reversed(lines):
+        try:
+            row = json.loads(line)
+        except (ValueError, RecursionError):
+            continue
+        if isinstance(row, dict) and row.get("kind") == "train" and \
+                all(isinstance(row.get(k), (int, float)) for k in ("global_step", "charts/SPS")):
+            return row["global_step"], row["charts/SPS"]
+    return 0, None
+
+
+def task_progress(task: List[Job], steps_per_run: int) -> float:
+    """The share of a task's training done, 0 to 1: its runs' steps so far (their metrics.jsonl), a finished
+    run's all of them, over its runs' steps in all."""
+    done = sum(steps_per_run if is_finished(job) else min(last_progress(os.path.join(job[2], "metrics.jsonl"))[0],
+                                                          steps_per_run) for job in task)
+    return done / (steps_per_run * len(task))
