@@ -13,7 +13,9 @@
 # tree afresh over the repository root, which must not change under a running process: a lease runs the code
 # of its first call. That call builds (lab/tools/device_build.sh) and starts DIR from the tasks already
 # published (PUBLISHED, default results/kage-bench-table/packs, unpacked with their checksums), so that only the
-# rest is trained.
+# rest is trained. The packs published so far ran shape_black's and image_skeleton's pairs in two parts of at most
+# 10 eval configs, which kage.bench run now refuses to extend (it runs them in one): start new work with
+# PUBLISHED=none.
 # Every call then waits until LIMIT seconds of the call have passed or the runner has ended, packing each task
 # as soon as all its runs have finished: its run data without checkpoints, in $OUT/task_I.tar.gz and
 # $OUT/task_I.sha256 (lab/tools/pack_task.py), so a call brings home what finished since the last; copy them

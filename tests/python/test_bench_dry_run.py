@@ -1,7 +1,9 @@
 """kage.bench run --dry-run: the task table and each GPU's tasks, with nothing trained or written. The expected
-tables are derived from the suite by hand: under --share-training KAGE-Bench's 34 pairs train 9 runs a seed, two
-evaluating 10 eval configs (image_skeleton's filters and background/9; shape_black's background, agent and
-distractors pairs), five evaluating 1 (background/4, /6, /7, /10 and layout/1), one 6 and one 3."""
+tables are derived from the suite by hand: under --share-training KAGE-Bench's 34 pairs train 7 runs a seed, one a
+train config: shape_black's evaluating 11 eval configs (its background, agent, distractors and layout pairs),
+image_skeleton's 13 (filters, background/9, effects), skeleton_black's 6, and four evaluating 1 (background/4, /6,
+/7 and /10). The task table groups them by eval configs, in the order the suite first names each count: 11, 1, 6,
+13."""
 import re
 
 import pytest
@@ -22,24 +24,27 @@ def test_the_table_and_the_gpus_tasks_with_nothing_written(capsys, tmp_path, mon
     assert status == 0
     assert not (tmp_path / "never-made").exists()
     lines = out.splitlines()
-    assert lines[0].startswith("kage.bench run --dry-run: 6 tasks, 45 runs (--pack 12, --share-training)")
-    # 10 runs of 11 configs; the 25 runs of 2 configs in packs of 12; then the 6-eval and the 3-eval units.
-    assert [line.split(":")[0] + ": " + line.split(": ")[1].split(",")[0] for line in lines[1:7]] == [
-        "task 0: 10 runs x 11 configs", "task 1: 12 runs x 2 configs", "task 2: 12 runs x 2 configs",
-        "task 3: 1 run x 2 configs", "task 4: 5 runs x 7 configs", "task 5: 5 runs x 4 configs"]
+    assert lines[0].startswith("kage.bench run --dry-run: 5 tasks, 35 runs (--pack 12, --share-training)")
+    # shape_black's 5 runs of 12 configs; the 20 runs of 2 configs in packs of 12; skeleton_black's 5 of 7;
+    # image_skeleton's 5 of 14.
+    assert [line.split(":")[0] + ": " + line.split(": ")[1].split(",")[0] for line in lines[1:6]] == [
+        "task 0: 5 runs x 12 configs", "task 1: 12 runs x 2 configs", "task 2: 8 runs x 2 configs",
+        "task 3: 5 runs x 7 configs", "task 4: 5 runs x 14 configs"]
     gpu_lines = [line for line in lines if line.startswith("  GPU ")]
     assert len(gpu_lines) == 4
     taken = [re.match(r"  GPU \d: tasks? ([\d, ]+), weight", line).group(1).split(", ") for line in gpu_lines]
-    assert sorted(int(task) for tasks in taken for task in tasks) == [0, 1, 2, 3, 4, 5]  # each task once
-    assert taken[0] == ["0"]  # the heaviest (10 runs of 11 configs) first, alone on its GPU
+    assert sorted(int(task) for tasks in taken for task in tasks) == [0, 1, 2, 3, 4]  # each task once
+    # weights (per run 1 + evals + 10): 110, 144, 96, 85, 120; the heaviest, task 1, first and alone on its GPU,
+    # then 4, 0 and 2 on the others, and 3 where 2 (the lightest of them) ends
+    assert taken == [["1"], ["4"], ["0"], ["2", "3"]]
 
 
 def test_only_the_tasks_named(capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    status, out = dry(capsys, "--pack", "12", "--gpus", "0,1", "--tasks", "4,5")
+    status, out = dry(capsys, "--pack", "12", "--gpus", "0,1", "--tasks", "3,4")
     assert status == 0
     gpu_lines = [line for line in out.splitlines() if line.startswith("  GPU ")]
-    assert gpu_lines[0].startswith("  GPU 0: task 4, weight 85") and gpu_lines[1].startswith("  GPU 1: task 5, ")
+    assert gpu_lines[0].startswith("  GPU 0: task 4, weight 120") and gpu_lines[1].startswith("  GPU 1: task 3, ")
 
 
 def test_the_gpus_are_named_as_given(capsys, tmp_path, monkeypatch):
@@ -51,7 +56,7 @@ def test_the_gpus_are_named_as_given(capsys, tmp_path, monkeypatch):
     assert "on 2 GPUs, longest first" in out
     gpu_lines = [line for line in out.splitlines() if line.startswith("  GPU ")]
     assert [line.split(":")[0] for line in gpu_lines] == ["  GPU 3", "  GPU 1"]
-    assert gpu_lines[0].startswith("  GPU 3: tasks 0, ")
+    assert gpu_lines[0].startswith("  GPU 3: tasks 1, 2, ")  # 144 and 96 against GPU 1's 120, 110 and 85
 
 
 def test_hand_out_gives_each_task_to_the_first_free_worker():

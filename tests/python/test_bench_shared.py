@@ -68,9 +68,49 @@ def test_shared_training_trains_once_and_reports_each_pair(tmp_path):
                              timeout=300)
     assert refused.returncode != 0 and "--share-training" in refused.stderr
 
+    # A folder whose pairs ran in parts of at most 10 eval configs (the published table's -part1 and -part2) is
+    # not mixed with this layout: its pairs' seeds would train again under the new name.
+    recorded["shared"]["background/1"][0] = unit + "-part1"
+    (shared / "bench.json").write_text(json.dumps(recorded))
+    mixed = subprocess.run([sys.executable, "-m", "kage.bench", "run", "suites/kage_bench.yaml", "--pairs", *PAIRS,
+                            "--seeds", "1", "--out", str(shared), "--share-training", *TINY], cwd=ROOT,
+                           capture_output=True, text=True, timeout=300)
+    assert mixed.returncode != 0
+    assert f"runs pair background/1 in {unit}-part1, this version in {unit}" in mixed.stderr, mixed.stderr
+    assert "into another --out" in mixed.stderr
+
+
+IMAGE_SKELETON_PAIRS = ["background/9", *(f"filters/{i}" for i in range(1, 10)), "effects/1", "effects/2", "effects/3"]
+
+
+def eval_rows(run_dir, labels):
+    """Per evaluation point, the named eval configs' results and differences to the train config."""
+    rows = [json.loads(line) for line in open(run_dir / "metrics.jsonl")]
+    return [(r["iteration"], {k: (r["evals"][k], r["diffs"][k]) for k in labels}) for r in rows if r["kind"] == "eval"]
+
+
+def test_a_run_of_more_than_10_eval_configs_evaluates_as_two_runs(tmp_path):
+    """IMAGE_SKELETON's 13 pairs share one run: its 11th to 13th eval configs (effects/1-3) take the 1st to 3rd's
+    evaluation seeds, so they log what a run of the same training evaluating effects/1-3 alone logs, and the
+    training is that run's."""
+    many, few = tmp_path / "many", tmp_path / "few"
+    bench("run", "suites/kage_bench.yaml", "--pairs", *IMAGE_SKELETON_PAIRS, "--seeds", "1", "--out", str(many),
+          "--share-training", *TINY)
+    bench("run", "suites/kage_bench.yaml", "--pairs", "effects/1", "effects/2", "effects/3", "--seeds", "1", "--out",
+          str(few), "--share-training", *TINY)
+    [unit] = json.loads((many / "bench.json").read_text())["units"]
+    assert json.loads((few / "bench.json").read_text())["units"] == [unit]  # one training, one run directory name
+    run_many, run_few = many / "runs" / unit / "seed_1", few / "runs" / unit / "seed_1"
+    labels = json.loads((run_many / "run.json").read_text())["args"]["eval_config_labels"]
+    assert labels == [p.replace("/", "_") for p in IMAGE_SKELETON_PAIRS]  # in this order: effects 11th to 13th
+    effects = ["effects_1", "effects_2", "effects_3"]
+    assert train_rows(run_many) == train_rows(run_few)
+    assert eval_rows(run_many, effects) == eval_rows(run_few, effects)
+    assert len(eval_rows(run_few, effects)) >= 2  # at least two evaluation points compared
+
 
 def test_shared_training_reaches_array_tasks(tmp_path):
-    """kage.bench slurm passes --share-training on to every task; the 340 runs of 10 seeds become 90."""
+    """kage.bench slurm passes --share-training on to every task; the 340 runs of 10 seeds become 70."""
     out = tmp_path / "array"
     bench("slurm", "suites/kage_bench.yaml", "--seeds", "1-10", "--pack", "8", "--out", str(out),
                  "--share-training")
@@ -78,6 +118,6 @@ def test_shared_training_reaches_array_tasks(tmp_path):
     assert "--share-training --task" in script
     table = json.loads((out / "tasks.json").read_text())["tasks"]
     runs = [(r["unit"], r["seed"]) for task in table for r in task]
-    assert len(runs) == len(set(runs)) == 90
+    assert len(runs) == len(set(runs)) == 70  # 7 train configs, each trained once a seed
     shared = json.loads((out / "bench.json").read_text())["shared"]
     assert len(shared) == 30  # the 34 pairs but the 4 with a train config of their own

@@ -74,15 +74,13 @@ def check_unit_name(name: str) -> None:
                          "backslash or control character): rename it in the suite")
 
 
-MAX_EVALS = 10  # eval configs per run (kage.ppo.train's limit, §3.5)
-
-
 def share_training(units: List[Unit], report: dict) -> List[Unit]:
     """--share-training: plain pairs whose training is one (train configs of one Spec, or mixtures or schedules
     of the same Specs, weights and stages: suite.json's train "spec_sha256") train once per seed, in one run
-    that evaluates all their eval configs (at most MAX_EVALS a run), each under its pair's name as label. A run
-    depends only on its training, seed and flags, so these pairs' separate runs would train the same agent;
-    the suite's 34 pairs have 7 train configs. Sweeps and pairs with a training of their own stay."""
+    that evaluates all their eval configs, each under its pair's name as label. A run depends only on its
+    training, seed and flags, so these pairs' separate runs would train the same agent; the suite's 34 pairs
+    have 7 train configs. Past 10 eval configs a run's evaluation seeds start again (evaluation_seed), as a
+    second run's would. Sweeps and pairs with a training of their own stay."""
     train_hash = {p["pair"]: p["train"]["spec_sha256"] for p in report["pairs"] if p["sweep"] is None}
     groups: Dict[str, List[Unit]] = {}
     for unit in units:
@@ -93,14 +91,10 @@ def share_training(units: List[Unit], report: dict) -> List[Unit]:
         if len(members) < 2:
             continue
         stem = train_stem(members[0].training)
-        chunks = [members[i:i + MAX_EVALS] for i in range(0, len(members), MAX_EVALS)]
-        for number, chunk in enumerate(chunks, 1):
-            part = f"-part{number}" if len(chunks) > 1 else ""
-            shared[chunk[0].name] = [Unit(f"shared/{stem}-{spec_hash[:8]}{part}", "(shared)",
-                                          [u.pairs[0] for u in chunk], shared=True,
-                                          labels={u.name: u.name.replace("/", "_") for u in chunk})]
-            for u in chunk[1:]:
-                shared[u.name] = []
+        shared[members[0].name] = [Unit(f"shared/{stem}-{spec_hash[:8]}", "(shared)", [u.pairs[0] for u in members],
+                                        shared=True, labels={u.name: u.name.replace("/", "_") for u in members})]
+        for u in members[1:]:
+            shared[u.name] = []
     return [v for u in units for v in shared.get(u.name, [u])]
 
 
@@ -148,6 +142,13 @@ def record_bench(out: str, manifest: str, seeds: List[int], units: List[Unit], t
         if previous.get("share_training", False) != share:
             raise SystemExit(f"kage.bench: {out} was started {'with' if not share else 'without'} "
                              "--share-training: use the same, or another --out")
+        for pair, (unit, _) in shared.items():
+            before = previous.get("shared", {}).get(pair)
+            if before and before[0] != unit:
+                raise SystemExit(f"kage.bench: {out} runs pair {pair} in {before[0]}, this version in {unit} (a run "
+                                 "now evaluates all the eval configs of its training, where it took at most 10 and "
+                                 "the rest went to a second run, -part2): report or compare it as it is, and train "
+                                 "more seeds or pairs into another --out")
         seeds = sorted(set(previous["seeds"]) | set(seeds))
         names = previous["units"] + [u for u in names if u not in previous["units"]]
         shared = {**previous.get("shared", {}), **shared}

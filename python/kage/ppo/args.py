@@ -315,8 +315,6 @@ def validate(args: Args) -> List[str]:
     n_evals = len(eval_paths(args))
     if args.eval_config_labels and len(args.eval_config_labels) != n_evals:
         problems.append(f"--eval-config-labels gives {len(args.eval_config_labels)} labels for {n_evals} eval configs")
-    if n_evals > 10:
-        problems.append("at most 10 eval configs (the 11th would reuse the train config's evaluation seeds, §3.5)")
     if args.device == "cpu" and (args.bf16 or args.cuda_graph):
         problems.append("--bf16 and --cuda-graph are for --device cuda")
     if args.video_every < 0:

@@ -16,6 +16,8 @@ from kage.ppo.wrappers import FrameStack
 
 COLUMN = {name: i for i, name in enumerate(RECORD_COLUMNS)}  # a record's columns by name (kage.fields)
 TRAIN_OFFSET, EVAL_OFFSET, EVAL_OFFSET_STEP = 20_000, 10_000, 1_000  # §3.2
+# The original's eval offsets below the train config's: its 11th eval config would take the train config's.
+EVAL_OFFSETS = (TRAIN_OFFSET - EVAL_OFFSET) // EVAL_OFFSET_STEP
 
 
 @dataclasses.dataclass(frozen=True)
@@ -41,8 +43,12 @@ class EvalTargets:
 
 def evaluation_seed(run_seed: int, config_index: int, iteration: int) -> int:
     """§3.2: the seed of a run's evaluation of its config_index-th config (0: the train config, offset 20,000;
-    i > 0: the i-th eval config, offset 10,000 + 1,000 (i - 1)) at `iteration`."""
-    offset = TRAIN_OFFSET if config_index == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * (config_index - 1)
+    i > 0: the i-th eval config, offset 10,000 + 1,000 (i - 1)) at `iteration`. Past the original's 10 eval
+    offsets (§3.5: its 11th would take the train config's) they start again: the 11th eval config takes the
+    1st's, as a second run of the same training evaluating configs 11 and on would, which the training does
+    not depend on."""
+    eval_slot = (config_index - 1) % EVAL_OFFSETS
+    offset = TRAIN_OFFSET if config_index == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * eval_slot
     return run_seed + offset + iteration
 
 
