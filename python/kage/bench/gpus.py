@@ -198,6 +198,6 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: O
         print(f"kage.bench run: task(s) {', '.join(map(str, sorted(failed)))} failed (kage.bench status "
               f"{bench.out}); rerun to resume them", file=sys.stderr)
         return 1
-    print(f"kage.bench run: {sum(len(table[i]) for i in chosen)} runs in {bench.out}; tables and plots: "
+    print(f"kage.bench run: {plural(sum(len(table[i]) for i in chosen), 'run')} in {bench.out}; tables and plots: "
           f"python3 -m kage.bench report {bench.out}", file=sys.stderr)
     return 0

@@ -48,6 +48,7 @@ from kage.errors import ConfigError
 from kage.util.files import atomic_write, os_error_text, read_json_record, read_regular, remove_strays, write_json
 from kage.util.lock import DirectoryLock, LockHeld
 from kage.util.stop import child_environment, die_with_parent, stop_children
+from kage.util.text import plural
 
 
 # The trainer flags kage.bench sets for each run (the trainer's parser takes no abbreviations of them).
@@ -581,6 +582,6 @@ def run_locked(bench: Bench, args: argparse.Namespace, devices: Optional[List[st
     else:
         status = train_jobs(bench, table[args.task], f"task_{args.task}_pack_", args.task)
     if status == 0 and args.task is None:
-        print(f"kage.bench run: {sum(map(len, table))} runs in {bench.out}; tables and plots: "
+        print(f"kage.bench run: {plural(sum(map(len, table)), 'run')} in {bench.out}; tables and plots: "
               f"python3 -m kage.bench report {bench.out}", file=sys.stderr)
     return status
