@@ -173,6 +173,30 @@ def test_status_calls_a_fresh_running_run_interrupted_when_its_runner_here_is_go
     assert f"its runner (pid {runs['killed']['pid']}, this host) is gone (killed?)" in line, line
 
 
+def test_status_gives_a_running_runs_steps_and_time_left(tmp_path):
+    """From its last training row and run.json's total: 3,000,000 of 25,000,000 steps at 20,000 steps/s leave
+    22,000,000 / 20,000 = 1,100 s, about 18 min. A run without a training row yet, or without run.json, says
+    nothing of it."""
+    bench = tmp_path / "bench"
+    fresh = {"state": "running", "time": time.time(), "host": socket.gethostname(), "pid": os.getpid()}
+    for unit in ("training", "starting", "unknown"):
+        (bench / "runs" / unit / "seed_1").mkdir(parents=True)
+        (bench / "runs" / unit / "seed_1" / "bench_state.json").write_text(json.dumps(fresh))
+    for unit in ("training", "starting"):
+        (bench / "runs" / unit / "seed_1" / "run.json").write_text(json.dumps({"args": {"total_timesteps": 25_000_000}}))
+    rows = [{"kind": "train", "global_step": 2_000_000, "charts/SPS": 19_000.0},
+            {"kind": "eval", "global_step": 3_000_000}, {"kind": "train", "global_step": 3_000_000, "charts/SPS": 20_000.0}]
+    (bench / "runs" / "training" / "seed_1" / "metrics.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    (bench / "runs" / "unknown" / "seed_1" / "metrics.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    (bench / "bench.json").write_text(json.dumps({"units": ["training", "starting", "unknown"], "seeds": [1]}))
+    out = io.StringIO()
+    assert status.status(str(bench), out)["running"] == ["training seed 1", "starting seed 1", "unknown seed 1"]
+    lines = {line.split(" seed 1")[0].strip(): line for line in out.getvalue().splitlines() if " seed 1:" in line}
+    assert "training seed 1: step 3,000,000 of 25,000,000, about 18 min left at its 20,000 steps/s; no checkpoint" \
+        in lines["training"], lines["training"]
+    assert "step" not in lines["starting"] and "step" not in lines["unknown"]
+
+
 def crafted(run, change):
     """The run's checkpoint with `change` applied, written with a valid digest (a file made to pass the
     integrity check: its content is what must be checked)."""

@@ -1,6 +1,8 @@
 """python3 -m kage.bench status DIR: where a benchmark stands, from the files its processes write (any
-number of them, on any hosts: a Slurm array, GPU workers, plain runs): runs done, running, failed (with
-the last error of each), stopped or killed (they resume when run again), and not started."""
+number of them, on any hosts: a Slurm array, GPU workers, plain runs): runs done, running (with their steps and
+the time left at their rate), failed (with the last error of each), stopped or killed (they resume when run
+again), and not started."""
+import json
 import os
 import socket
 import time
@@ -9,11 +11,25 @@ from typing import Dict, List, TextIO
 from kage.bench import run_state
 from kage.bench.records import bench_problem
 from kage.bench.run import checkpoint_iteration
-from kage.bench.tasks import run_dir
-from kage.util.files import process_alive, read_json_record
+from kage.bench.tasks import last_progress, run_dir
+from kage.util.files import process_alive, read_json_record, read_regular
 from kage.util.text import plural
 
 ORDER = ("done", "running", "failed", "interrupted", "not started")
+
+
+def progress(path: str) -> str:
+    """A running run's steps so far and what is left at its rate, from its metrics.jsonl and run.json ("" before
+    its first training row, or where run.json names no total)."""
+    step, rate = last_progress(os.path.join(path, "metrics.jsonl"))
+    try:
+        total = json.loads(read_regular(os.path.join(path, "run.json")))["args"]["total_timesteps"]
+    except (OSError, ValueError, KeyError, TypeError, RecursionError):  # absent, damaged, not a run description
+        return ""
+    if not rate or not isinstance(total, int) or total <= 0:
+        return ""
+    left = max(total - step, 0) / rate / 60
+    return f"step {step:,} of {total:,}, about {left:,.0f} min left at its {rate:,.0f} steps/s; "
 
 
 def classify(path: str, now: float) -> tuple:
@@ -37,7 +53,7 @@ def classify(path: str, now: float) -> tuple:
         pid = state.get("pid")
         if state["host"] == socket.gethostname() and isinstance(pid, int) and not process_alive(pid):
             return "interrupted", f"its runner (pid {pid}, this host) is gone (killed?); {at}; {where}"
-        return "running", f"{at}; {where}"
+        return "running", f"{progress(path)}{at}; {where}"
     if state["state"] == "failed":
         return "failed", (f"exit {state.get('exit_code', '?')} ({where}, log {state.get('log', '?')}): "
                           f"{state.get('error', '?')}")
