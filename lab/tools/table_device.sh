@@ -11,11 +11,11 @@
 # call returns, so it trains on through the lease's calls and the gaps between them, never stopped and resumed.
 # It runs from a copy of the tree made by the lease's first call (ROOT), since every call copies the working
 # tree afresh over the repository root, which must not change under a running process: a lease runs the code
-# of its first call. That call builds (lab/tools/device_build.sh) and starts DIR from the tasks already
-# published (PUBLISHED, default results/kage-bench-table/packs, unpacked with their checksums), so that only the
-# rest is trained. The packs published so far ran shape_black's and image_skeleton's pairs in two parts of at most
-# 10 eval configs, which kage.bench run now refuses to extend (it runs them in one): start new work with
-# PUBLISHED=none.
+# of its first call. That call builds (lab/tools/device_build.sh) and, with PUBLISHED=FOLDER, starts DIR from the
+# tasks already published there (unpacked with their checksums), so that only the rest is trained. The packs
+# published so far (results/) ran shape_black's and image_skeleton's pairs in two parts of at most 10 eval
+# configs, which kage.bench run now refuses to extend (it runs them in one): the default, PUBLISHED=none, starts
+# DIR empty.
 # Every call then waits until LIMIT seconds of the call have passed or the runner has ended, packing each task
 # as soon as all its runs have finished: its run data without checkpoints, in $OUT/task_I.tar.gz and
 # $OUT/task_I.sha256 (lab/tools/pack_task.py), so a call brings home what finished since the last; copy them
@@ -32,8 +32,9 @@
 # bench.json records it. COMMIT names the tree's commit (the machine gets no .git) for the
 # packs' provenance, beside the device, the command (each call that started the runner, which trained the
 # task), the call that packed it, and when it was trained and packed. A call copies the working tree and its carry,
-# which must stay under the device's 64 MiB: the published run data outgrow that, so move every results/ folder but
-# PUBLISHED out of the working tree for the lease's calls (the deletions are not committed) and back afterwards.
+# which must stay under the device's 64 MiB: the published run data outgrow that, so move every results/ folder
+# (but PUBLISHED) out of the working tree for the lease's calls (the deletions are not committed) and back
+# afterwards.
 # Run with carry [".deps"]:
 #   COMMIT=$(git rev-parse --short HEAD) GPUS=all PACK=6 bash lab/tools/table_device.sh
 #   COMMIT=... TASK=0 PACK=6 bash lab/tools/table_device.sh
@@ -52,7 +53,7 @@ DIR=${DIR:-/tmp/kage-table}
 LIMIT=${LIMIT:-585}
 MAX_FILES=${MAX_FILES:-8}
 FLAGS=${FLAGS:---bf16 --fused-input --cuda-graph --triton-conv}
-PUBLISHED=${PUBLISHED:-results/kage-bench-table/packs}
+PUBLISHED=${PUBLISHED:-none}
 SUITE=${SUITE:-kage_bench}
 SEEDS=${SEEDS:-1-10}
 export TRITON_CACHE_DIR=${TRITON_CACHE_DIR:-/tmp/kage-triton-cache}  # compiled kernels kept for the lease
