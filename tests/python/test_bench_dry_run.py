@@ -34,9 +34,9 @@ def test_the_table_and_the_gpus_tasks_with_nothing_written(capsys, tmp_path, mon
     assert len(gpu_lines) == 4
     taken = [re.match(r"  GPU \d: tasks? ([\d, ]+), weight", line).group(1).split(", ") for line in gpu_lines]
     assert sorted(int(task) for tasks in taken for task in tasks) == [0, 1, 2, 3, 4]  # each task once
-    # weights (per run 1 + evals + 10): 110, 144, 96, 85, 120; the heaviest, task 1, first and alone on its GPU,
-    # then 4, 0 and 2 on the others, and 3 where 2 (the lightest of them) ends
-    assert taken == [["1"], ["4"], ["0"], ["2", "3"]]
+    # weights (per run 1 + evals + 40): 260, 504, 336, 235, 270; the heaviest, task 1, first and alone on its GPU,
+    # then 2, 4 and 0 on the others, and 3 where 0 (the lightest of them) ends
+    assert taken == [["1"], ["2"], ["4"], ["0", "3"]]
 
 
 def test_only_the_tasks_named(capsys, tmp_path, monkeypatch):
@@ -44,7 +44,7 @@ def test_only_the_tasks_named(capsys, tmp_path, monkeypatch):
     status, out = dry(capsys, "--pack", "12", "--gpus", "0,1", "--tasks", "3,4")
     assert status == 0
     gpu_lines = [line for line in out.splitlines() if line.startswith("  GPU ")]
-    assert gpu_lines[0].startswith("  GPU 0: task 4, weight 120") and gpu_lines[1].startswith("  GPU 1: task 3, ")
+    assert gpu_lines[0].startswith("  GPU 0: task 4, weight 270") and gpu_lines[1].startswith("  GPU 1: task 3, ")
 
 
 def test_the_gpus_are_named_as_given(capsys, tmp_path, monkeypatch):
@@ -56,7 +56,7 @@ def test_the_gpus_are_named_as_given(capsys, tmp_path, monkeypatch):
     assert "on 2 GPUs, longest first" in out
     gpu_lines = [line for line in out.splitlines() if line.startswith("  GPU ")]
     assert [line.split(":")[0] for line in gpu_lines] == ["  GPU 3", "  GPU 1"]
-    assert gpu_lines[0].startswith("  GPU 3: tasks 1, 2, ")  # 144 and 96 against GPU 1's 120, 110 and 85
+    assert gpu_lines[0].startswith("  GPU 3: tasks 1, 0, ")  # 504 and 260 against GPU 1's 336, 270 and 235
 
 
 def test_hand_out_gives_each_task_to_the_first_free_worker():

@@ -158,6 +158,6 @@ def test_tasks_are_handed_out_longest_first():
     assert weights == [6 * (2 + gpus.TRAINING_AS_CONFIGS), 4 * (10 + gpus.TRAINING_AS_CONFIGS),
                        2 * (2 + gpus.TRAINING_AS_CONFIGS), 6 * (6 + gpus.TRAINING_AS_CONFIGS),
                        6 * (6 + gpus.TRAINING_AS_CONFIGS)]
-    # 72, 80, 24, 96, 96 at TRAINING_AS_CONFIGS = 10: tasks 3 and 4 tie (table order), then 1, 0 and 2
-    assert gpus.longest_first(table, [0, 1, 2, 3, 4]) == [3, 4, 1, 0, 2]
+    # 252, 200, 84, 276, 276 at TRAINING_AS_CONFIGS = 40: tasks 3 and 4 tie (table order), then 0, 1 and 2
+    assert gpus.longest_first(table, [0, 1, 2, 3, 4]) == [3, 4, 0, 1, 2]
     assert gpus.longest_first(table, [0, 2]) == [0, 2]

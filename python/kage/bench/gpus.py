@@ -49,10 +49,11 @@ def parse_gpus(text: str, trainer_device: str) -> List[str]:
     return [visible[i] if visible else str(i) for i in indices]
 
 
-# A run's training costs about as much as evaluating this many configs over its 32 evaluation points: on 4 x H100
-# (results/kage-bench-table/leases/2026-11-26-h100x4-2.md) a pack of 6 runs with 7 configs each trained in 448 s
-# and evaluated in 321 s, 7.6 s per run and config.
-TRAINING_AS_CONFIGS = 10
+# A run's training costs about as much as evaluating this many configs over its 32 evaluation points, since the
+# evaluation steps on the device: on 4 x H200 (lab/2026-11-29-h200x4-drac-random-conv-tasks-5-8) DrAC's packs of 5
+# trained 160-167 s a run and evaluated 3.3-4.8 s a run and config (2 to 7 configs; 35-48 to one), the baseline's
+# trainer 202 s a run in packs of 2 against 5.5 s (37). (The table's packs, evaluated from the host: 6-13.)
+TRAINING_AS_CONFIGS = 40
 
 
 def task_weight(task: List[tasks.Job]) -> int:
