@@ -47,9 +47,9 @@ def evaluation_seed(run_seed: int, config_index: int, iteration: int) -> int:
     offsets (§3.5: its 11th would take the train config's) they start again: the 11th eval config takes the
     1st's, as a second run of the same training evaluating configs 11 and on would, which the training does
     not depend on."""
-    eval_slot = (config_index - 1) % EVAL_OFFSETS
-    offset = TRAIN_OFFSET if config_index == 0 else EVAL_OFFSET + EVAL_OFFSET_STEP * eval_slot
-    return run_seed + offset + iteration
+    if config_index == 0:
+        return run_seed + TRAIN_OFFSET + iteration
+    return run_seed + EVAL_OFFSET + EVAL_OFFSET_STEP * ((config_index - 1) % EVAL_OFFSETS) + iteration
 
 
 class EpisodeMetrics:
