@@ -10,8 +10,8 @@ runner of all tasks (`kage.bench run --gpus`) whose tasks finish while it runs: 
 runner has also marked each run done (bench_state.json), since until its trainer exits it rewrites that file
 every 30 s, and a file rewritten between the archive and its checksum would not match on unpacking. With
 MAX_FILES (the device machine's limit on the files a call brings back), `new` packs a task as its two files
-while they fit, then the rest into one file, DEST/more_tasks.tar (each task's two files; `tar xf` it into the
-packs folder at home), since the call that finds the runner ended may be the lease's last; only when not even
+while they fit, then the rest into one file, DEST/more_tasks.tar (each task's two files, which
+lab/tools/packs_publish.py publishes at home), since the call that finds the runner ended may be the lease's last; only when not even
 that fits does it name the finished tasks it left for the next call and exit with status 3
 (LEFT_FOR_NEXT_CALL), so that the call can end at once and the next bring them home before the lease ends.
 

@@ -18,9 +18,10 @@
 # DIR empty.
 # Every call then waits until LIMIT seconds of the call have passed or the runner has ended, packing each task
 # as soon as all its runs have finished: its run data without checkpoints, in $OUT/task_I.tar.gz and
-# $OUT/task_I.sha256 (lab/tools/pack_task.py), so a call brings home what finished since the last; copy them
-# into results/kage-bench-table/packs at once. Tasks past the file limit come in one file, $OUT/more_tasks.tar:
-# `tar xf` it into the packs folder. A call that finds no runner with tasks left (it failed, or the
+# $OUT/task_I.sha256 (lab/tools/pack_task.py), so a call brings home what finished since the last; publish them
+# at once (`python3 lab/tools/packs_publish.py FILES_AT PACKS --note '...'`, PACKS results/kage-bench-table/packs
+# or results/methods/METHOD/packs). Tasks past the file limit come in one file, $OUT/more_tasks.tar, which
+# packs_publish.py publishes too. A call that finds no runner with tasks left (it failed, or the
 # first call's ended) starts one again, which resumes the runs from their checkpoints. $OUT holds at most
 # MAX_FILES (the device's limit on the files a call brings back): the call's log, $OUT/call.log (the build's
 # lines, then the runner's since the last call), and the tasks, the last ones bundled; a finished task left over
