@@ -1,6 +1,7 @@
 """What the training loop carries across iterations (LoopState) and each run's checkpoint of it: written after an
 iteration (save_checkpoints), checked against what this run would write (checkpoint_problem) and loaded to resume
 a pack exactly where it stopped (resume). The files themselves are kage.ppo.rundir's and kage.ppo.checkpoint's."""
+import functools
 import math
 import os
 import sys
@@ -11,6 +12,7 @@ import torch
 
 from kage.ppo import checkpoint, rundir, schedule, streams
 from kage.ppo.args import Args
+from kage.ppo.checkpoint_writer import CheckpointWriter
 from kage.ppo.runs import BatchViews, Run, enter_stage
 
 
@@ -51,12 +53,14 @@ class LoopState:
                 "any_finished": self.any_finished.float()}
 
 
-def save_checkpoints(runs: List[Run], agent, optimizer, state: LoopState, stack, normalizer, agent_spec: dict) -> None:
+def save_checkpoints(runs: List[Run], agent, optimizer, state: LoopState, stack, normalizer, agent_spec: dict,
+                     writer: CheckpointWriter) -> None:
     """Each run's checkpoint (kage.ppo.rundir): its parameters and optimizer state, its environments' state, and
-    its part of the loop state."""
-    for k, run in enumerate(runs):
-        run.dir.save_checkpoint(run_checkpoint(k, run, agent, rundir.optimizer_run_state(optimizer, agent, k), state,
-                                               stack, normalizer, agent_spec))
+    its part of the loop state, copied now and written by `writer` while training goes on."""
+    snapshots = [run.dir.checkpoint_snapshot(run_checkpoint(
+        k, run, agent, rundir.optimizer_run_state(optimizer, agent, k), state, stack, normalizer, agent_spec))
+        for k, run in enumerate(runs)]
+    writer.submit([functools.partial(run.dir.write_checkpoint, snapshot) for run, snapshot in zip(runs, snapshots)])
 
 
 def run_checkpoint(k: int, run: Run, agent, optimizer_state: dict, state: LoopState, stack, normalizer,
@@ -67,10 +71,12 @@ def run_checkpoint(k: int, run: Run, agent, optimizer_state: dict, state: LoopSt
         "train_seconds": state.train_seconds,
         "agent": {n: agent.run_view(p)[k].detach().cpu().clone() for n, p in agent.named_parameters()},
         "optimizer": optimizer_state, "env_state": run.env.save_state(),
-        "frame_stack": stack.stack[k].cpu() if stack else None,
-        "normalizer": {n: v[k].cpu() for n, v in normalizer.state_dict().items()} if normalizer else None,
-        "history": run.history, "agent_spec": dict(agent_spec, seed=run.args.seed)}
-    saved.update({key: getattr(state, key)[k].cpu() for key in LoopState.TENSORS})
+        "frame_stack": stack.stack[k].to("cpu", copy=True) if stack else None,
+        "normalizer": ({n: v[k].to("cpu", copy=True) for n, v in normalizer.state_dict().items()}
+                       if normalizer else None),
+        "history": list(run.history), "agent_spec": dict(agent_spec, seed=run.args.seed)}
+    # Copies even on a CPU device, where .cpu() is the live tensor: the checkpoint is written while training goes on.
+    saved.update({key: getattr(state, key)[k].to("cpu", copy=True) for key in LoopState.TENSORS})
     return saved
 
 

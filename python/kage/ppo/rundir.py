@@ -198,14 +198,20 @@ class RunDir:
 
     # ---- checkpoints ----
 
-    def save_checkpoint(self, state: dict) -> None:
-        """checkpoints/latest.pt, and latest.json naming its iteration (read by kage.bench to pack runs
-        that resume from the same iteration without loading the checkpoints)."""
+    def checkpoint_snapshot(self, state: dict) -> dict:
+        """`state` (copies of the run's tensors, not the ones training goes on changing) with what proves it this
+        run's: its identity, and the log it ends (metrics.jsonl's bytes, rows and SHA-256 so far)."""
         self._check_still_held()
-        state = dict(state, identity=self.identity,
-                     log={"bytes": self._log_bytes, "rows": self._log_rows, "sha256": self._log_digest.hexdigest()})
-        atomic_write(os.path.join(self.path, "checkpoints", "latest.pt"), checkpoint.encode(state))
-        write_json(os.path.join(self.path, "checkpoints", "latest.json"), {"iteration": state["iteration"]})
+        return dict(state, identity=self.identity,
+                    log={"bytes": self._log_bytes, "rows": self._log_rows, "sha256": self._log_digest.hexdigest()})
+
+    def write_checkpoint(self, snapshot: dict) -> None:
+        """checkpoints/latest.pt, and latest.json naming its iteration (read by kage.bench to pack runs
+        that resume from the same iteration without loading the checkpoints); on the checkpoint writer's thread
+        (kage.ppo.checkpoint_writer)."""
+        self._check_still_held()
+        atomic_write(os.path.join(self.path, "checkpoints", "latest.pt"), checkpoint.encode(snapshot))
+        write_json(os.path.join(self.path, "checkpoints", "latest.json"), {"iteration": snapshot["iteration"]})
 
     def load_checkpoint(self) -> Optional[dict]:
         """The latest checkpoint, proven to be this run's (and the log cut back to it), or None for a fresh run

@@ -55,6 +55,7 @@ from kage.fields import EPISODE_METRICS as METRICS
 from kage.ppo import plugins, rundir, schedule, streams, tensorboard_log, video
 from kage.ppo.agent import frames_at
 from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args
+from kage.ppo.checkpoint_writer import CheckpointWriter
 from kage.ppo.counter_random import CounterRandom
 from kage.ppo.evaluation import EvalSettings, EvalTargets, evaluation_rows
 from kage.ppo.loop_state import LoopState, resume, save_checkpoints
@@ -81,12 +82,13 @@ def train(pack: List[Args], timer=None, stop_after: Optional[int] = None,
     requested (a signal), checkpoints after the running iteration and exits. Each run directory is locked from
     its opening to the end (kage.util.lock)."""
     pack = [rundir.with_augment_mode(a) for a in pack]
-    with rundir.held_open():
-        return train_locked(pack, timer, stop_after, stop)
+    with rundir.held_open(), CheckpointWriter() as writer:  # the files in flight land before the directories unlock
+        return train_locked(pack, timer, stop_after, stop, writer)
 
 
-def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optional[StopRequest]) -> List[Run]:
-    """train(), with its run directories closed by the caller."""
+def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optional[StopRequest],
+                 writer: CheckpointWriter) -> List[Run]:
+    """train(), with its run directories closed and its checkpoints' writer waited for by the caller."""
     args = check_pack(pack)
     stop = stop or StopRequest("kage.ppo.train", "")
     timer = timer or NoTimer()
@@ -303,7 +305,9 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                 board.write(run.dir.log(row))
         if (args.save_checkpoint_every > 0 and iteration % args.save_checkpoint_every == 0) or \
                 iteration == args.num_iterations or stop.requested:  # §2.5 step 7, at the end, and when asked
-            save_checkpoints(runs, agent, optimizer, state, stack, normalizer, agent_spec)
+            save_checkpoints(runs, agent, optimizer, state, stack, normalizer, agent_spec, writer)
+            if iteration == last_iteration or stop.requested:
+                writer.wait()  # landed before summary.json, or before the exit that says the runs are checkpointed
         progress.update(iteration, state.global_step * K, {"charts/SPS": state.global_step * K / state.train_seconds},
                         eval_rows[0] if eval_rows else None)
         if stop.requested and iteration < last_iteration:
