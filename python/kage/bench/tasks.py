@@ -16,8 +16,9 @@ def run_dir(out: str, unit_name: str, seed: int) -> str:
 
 
 def task_table(units: Sequence, seeds: Sequence[int], pack: int, out: str) -> List[List[Job]]:
-    """Runs that evaluate the same number of configs share tasks (a pack steps in lockstep); within that,
-    manifest order, seeds innermost."""
+    """Runs that evaluate the same number of configs share tasks (a pack's evaluation pads each run to its runs'
+    most configs, kage.ppo.evaluation, which this layout never needs); within that, manifest order, seeds
+    innermost."""
     groups: Dict[int, List[Job]] = {}
     for unit in units:
         for seed in seeds:

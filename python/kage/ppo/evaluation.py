@@ -2,6 +2,7 @@
 pack evaluated on its train config and each eval config at once, in fresh environments, and the
 metrics read from the finished episodes' final info."""
 import dataclasses
+import itertools
 import time
 from typing import Dict, List, Optional
 
@@ -82,21 +83,39 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
     synchronisation: every KAGE episode ends by truncation at `episode_length` (§2.3), so
     ceil(episodes / envs) waves of episode_length steps finish them; the records stay on the device until the
     host reads them once, after the waves, and checks the counts there (it steps on, as many waves again, if one
-    fell short)."""
+    fell short). Runs may evaluate different numbers of configs: the policy sees every run's C slots (C the
+    most), a run's slots past its own configs hold blank frames that no environment steps and no result reads."""
     device = next(agent.parameters()).device
     flat_envs = [e for run in envs for e in run]
+    flat_seeds = [s for run in seeds for s in run]
     specs = [env.resolved_specs[0]["config"] for env in flat_envs]  # the hidden game's: a mixture's configs share it
     episode_length = max(c["episode_length"] for c in specs)
-    configs, n, num_actions = len(envs[0]), flat_envs[0].num_envs, flat_envs[0].single_action_space.n
-    random = CounterRandom([s for run in seeds for s in run], device)
+    configs, n, num_actions = max(map(len, envs)), flat_envs[0].num_envs, flat_envs[0].single_action_space.n
+    # slot k * C + c: run k's c-th config, or padding (-1); a stream's draws depend on its own seed alone, so the
+    # padding's streams (seed 0) change no evaluation's actions.
+    slot_env = [c for run in envs for c in list(range(len(run))) + [-1] * (configs - len(run))]
+    real = [i for i, c in enumerate(slot_env) if c >= 0]
+    padded = len(real) < len(slot_env)
+    slot_seeds = iter(flat_seeds)
+    random = CounterRandom([next(slot_seeds) if c >= 0 else 0 for c in slot_env], device)
     counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
     infos = []
-    for env, seed in zip(flat_envs, [s for run in seeds for s in run]):
+    for env, seed in zip(flat_envs, flat_seeds):
         infos.append(env.reset(seed=seed)[1])
     env_streams = streams.streams_of(flat_envs)  # the trainer's: a stream per run (kage.ppo.streams)
     streams.wait_for(env_streams)
     frames = [torch.from_dlpack(env.outputs()[0]) for env in flat_envs]
+    if padded:
+        blank, by_env = torch.zeros_like(frames[0]), iter(frames)
+        frames = [next(by_env) if c >= 0 else blank for c in slot_env]
+        real_slots = torch.tensor(real, device=device)
     metrics = EpisodeMetrics(infos, [c["dist_to_success"] for c in specs], device)
+
+    def slot_mask() -> torch.Tensor:
+        """The episodes that just ended, [K * C, E]: none in the padding."""
+        mask = metrics.mask()
+        return torch.zeros((len(slot_env), n), device=device).index_copy_(0, real_slots, mask) if padded else mask
+
     stack = FrameStack(torch.stack(frames)) if settings.frame_stack else None
     episodes = settings.episodes
     chunk = -(-episodes // n) * episode_length
@@ -108,10 +127,11 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
         actions, _, _ = policy_step(agent, obs.view(len(envs), configs * n, *obs.shape[2:]),
                                     uniform.reshape(len(envs), configs * n, num_actions),
                                     bf16=settings.bf16, greedy=settings.greedy)
-        kage.step_batches(flat_envs, actions.view(len(flat_envs), n))
+        actions = actions.view(len(slot_env), n)
+        kage.step_batches(flat_envs, actions.index_select(0, real_slots) if padded else actions)
         streams.wait_for(env_streams)
         if stack:
-            stack.push(torch.stack(frames), metrics.mask())
+            stack.push(torch.stack(frames), slot_mask())
         return metrics.rows()
 
     graph = StepGraph(step) if graphable(settings, flat_envs) else None
@@ -124,7 +144,8 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
         if host[:, :, 0].sum((0, 2)).min().item() >= episodes:
             break
     results = [summarize_evaluation(host[:, i], episodes) for i in range(len(flat_envs))]
-    return [results[k * configs:(k + 1) * configs] for k in range(len(envs))]
+    ends = list(itertools.accumulate(map(len, envs)))
+    return [results[end - len(run):end] for run, end in zip(envs, ends)]
 
 
 def graphable(settings: EvalSettings, envs: List["kage.VecEnv"]) -> bool:

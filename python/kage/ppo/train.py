@@ -54,7 +54,7 @@ import kage
 from kage.fields import EPISODE_METRICS as METRICS
 from kage.ppo import plugins, rundir, schedule, streams, tensorboard_log, video
 from kage.ppo.agent import frames_at
-from kage.ppo.args import PER_RUN, Args, configs_of, eval_paths, parse_args
+from kage.ppo.args import PER_RUN, Args, configs_of, parse_args
 from kage.ppo.checkpoint_writer import CheckpointWriter
 from kage.ppo.counter_random import CounterRandom
 from kage.ppo.evaluation import EvalSettings, EvalTargets, evaluation_rows
@@ -155,7 +155,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
     progress = rundir.Progress(args.num_iterations, args.batch_size * K,
                                args.run_eval_every if runs[0].eval_envs else 0)
     if not resumed and runs[0].eval_envs:
-        progress.evaluating(0, len(runs[0].eval_envs), args.eval_episodes)
+        progress.evaluating(0, max(len(run.eval_envs) for run in runs), args.eval_episodes)
         with timer("eval"):  # §3.1: the untrained policy
             evaluation_point(agent, runs, boards, settings, args, 0, 0)
         progress.evaluated()
@@ -295,7 +295,7 @@ def train_locked(pack: List[Args], timer, stop_after: Optional[int], stop: Optio
                           optimizer.param_groups[0]["lr"], ent_coef)
         eval_rows = []
         if runs[0].eval_envs and (iteration % args.run_eval_every == 0 or iteration == last_iteration):
-            progress.evaluating(iteration, len(runs[0].eval_envs), args.eval_episodes)
+            progress.evaluating(iteration, max(len(run.eval_envs) for run in runs), args.eval_episodes)
             with timer("eval"), clock.paused():  # §2.5 step 6, and §3.1's final point
                 eval_rows = evaluation_point(agent, runs, boards, settings, args, iteration, state.global_step,
                                              train_rows=rows)
@@ -352,15 +352,14 @@ def minibatch_loss(agent, plain: Optional[tuple], augmented: Optional[torch.Tens
 
 
 def check_pack(runs: List[Args]) -> Args:
-    """The pack's shared arguments: every run must agree on all but PER_RUN and on the number of eval configs."""
+    """The pack's shared arguments: every run must agree on all but PER_RUN (its configs among them: runs may
+    evaluate different numbers of configs, kage.ppo.evaluation)."""
     first = dataclasses.asdict(runs[0])
     for args in runs[1:]:
         other = dataclasses.asdict(args)
         differ = [k for k in first if k not in PER_RUN and first[k] != other[k]]
         if differ:
             raise SystemExit(f"kage.ppo.train: packed runs must share {', '.join(differ)}")
-        if len(eval_paths(args)) != len(eval_paths(runs[0])):
-            raise SystemExit("kage.ppo.train: packed runs must evaluate the same number of configs")
     return runs[0]
 
 
