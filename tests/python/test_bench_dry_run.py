@@ -9,6 +9,7 @@ import re
 import pytest
 
 from kage.bench import gpus, run
+from kage.bench.units import Unit
 from support import ROOT
 
 
@@ -117,3 +118,35 @@ def test_the_shipped_suite_has_no_config_warnings(capsys, tmp_path, monkeypatch)
     assert run.main(["kage_bench", "--seeds", "1", "--out", "never-made", "--dry-run"]) == 0
     captured = capsys.readouterr()
     assert "kage.bench run --dry-run:" in captured.out and "warning" not in captured.err
+
+
+def test_mixed_eval_counts_pack_runs_in_manifest_order(capsys, tmp_path, monkeypatch):
+    """--mix-eval-counts: the 35 runs in the suite's order (shape_black at background/1, then background/4, /6, /7,
+    skeleton_black at background/8, image_skeleton at background/9, background/10; seeds innermost) in tasks of
+    12, whatever their eval counts. Weights, per run 1 + evals + 40: shape_black 52, skeleton_black 47,
+    image_skeleton 54, a background pair 42."""
+    monkeypatch.chdir(tmp_path)
+    status, out = dry(capsys, "--pack", "12", "--mix-eval-counts")
+    assert status == 0
+    lines = out.splitlines()
+    assert lines[0].startswith("kage.bench run --dry-run: 3 tasks, 35 runs (--pack 12, --share-training, "
+                               "--mix-eval-counts)")
+    assert [line.split(":")[0] + ": " + line.split(": ")[1] for line in lines[1:4]] == [
+        # 5 shape_black, 5 background/4, 2 background/6: 5 x 52 + 7 x 42
+        "task 0: 12 runs x 2-12 configs, weight 554",
+        # 3 background/6, 5 background/7, 4 skeleton_black: 8 x 42 + 4 x 47
+        "task 1: 12 runs x 2-7 configs, weight 524",
+        # 1 skeleton_black, 5 image_skeleton, 5 background/10: 47 + 5 x 54 + 5 x 42
+        "task 2: 11 runs x 2-14 configs, weight 527"]
+
+
+def test_packs_of_mixes_eval_counts_only_when_asked():
+    def job(name, evals, seed):
+        pairs = [{"pair": f"{name}/{i}", "train": {"name": "t.yaml"}, "eval": {"name": f"e{i}.yaml"}}
+                 for i in range(evals)]
+        return Unit(name, "axis", pairs), seed, f"/none/{name}/{seed}"
+
+    jobs = [job("a", 3, 1), job("b", 1, 1), job("a", 3, 2)]
+    assert [[j[2] for j in p] for p in run.packs_of(jobs, 4)] == [["/none/a/1", "/none/a/2"], ["/none/b/1"]]
+    assert [[j[2] for j in p] for p in run.packs_of(jobs, 4, mix_eval_counts=True)] == [
+        ["/none/a/1", "/none/b/1", "/none/a/2"]]

@@ -121,3 +121,21 @@ def test_shared_training_reaches_array_tasks(tmp_path):
     assert len(runs) == len(set(runs)) == 70  # 7 train configs, each trained once a seed
     shared = json.loads((out / "bench.json").read_text())["shared"]
     assert len(shared) == 30  # the 34 pairs but the 4 with a train config of their own
+
+
+def test_mixed_eval_counts_train_one_pack(tmp_path):
+    """--mix-eval-counts: the shared run (2 eval configs) and background/4's (1) train in one pack, each evaluating
+    its own configs and no other."""
+    out = tmp_path / "mixed"
+    bench("run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out), "--share-training",
+          "--pack", "2", "--mix-eval-counts", *TINY)
+    pack = json.loads((out / "packs" / "pack_0.json").read_text())
+    assert len(pack["runs"]) == 2 and not (out / "packs" / "pack_1.json").exists()
+    unit = json.loads((out / "bench.json").read_text())["units"][0]
+    expected = {unit: {"background_1", "agent_appearance_1"}, "background/4": {"eval"}}
+    for name, labels in expected.items():
+        rows = [json.loads(line) for line in open(out / "runs" / name / "seed_1" / "metrics.jsonl")]
+        evals = [r for r in rows if r["kind"] == "eval"]
+        assert [r["iteration"] for r in evals] == [0, 2]
+        assert all(set(r["evals"]) == labels for r in evals)
+        assert (out / "runs" / name / "seed_1" / "summary.json").exists()

@@ -12,10 +12,12 @@ def describe(bench, devices: Optional[List[int]], only: Optional[List[int]]) -> 
     table = bench.table()
     lines = [f"kage.bench run --dry-run: {plural(len(table), 'task')}, {plural(sum(map(len, table)), 'run')} "
              f"(--pack {bench.pack}"
-             f"{', --share-training' if bench.share_training else ''}); nothing trained or written"]
+             f"{', --share-training' if bench.share_training else ''}"
+             f"{', --mix-eval-counts' if bench.mix_eval_counts else ''}); nothing trained or written"]
     for i, task in enumerate(table):
         units = sorted({unit.name for unit, _, _ in task})
-        configs = 1 + len(task[0][0].evals)
+        counts = sorted({1 + len(unit.evals) for unit, _, _ in task})
+        configs = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}"
         lines.append(f"task {i}: {plural(len(task), 'run')} x {configs} configs, weight {gpus.task_weight(task)}: "
                      f"{', '.join(units)}")
     if devices:

@@ -208,13 +208,14 @@ def training_shape(unit: Unit) -> tuple:
     return ("mixture", len(train["stages"][0]["configs"]))
 
 
-def packs_of(jobs: List[tuple], size: int) -> List[List[tuple]]:
+def packs_of(jobs: List[tuple], size: int, mix_eval_counts: bool = False) -> List[List[tuple]]:
     """Jobs (unit, seed, run_dir) in packs of at most `size`: a pack's runs evaluate the same number of
-    configs, train on the same kind of thing (training_shape) and resume from the same iteration (they step
-    in lockstep)."""
+    configs (unless `mix_eval_counts`), train on the same kind of thing (training_shape) and resume from the
+    same iteration (they step in lockstep)."""
     groups: Dict[tuple, List[tuple]] = {}
     for job in jobs:
-        groups.setdefault((len(job[0].evals), training_shape(job[0]), checkpoint_iteration(job[2])), []).append(job)
+        count = None if mix_eval_counts else len(job[0].evals)
+        groups.setdefault((count, training_shape(job[0]), checkpoint_iteration(job[2])), []).append(job)
     return [group[i:i + size] for group in groups.values() for i in range(0, len(group), size)]
 
 
@@ -283,17 +284,18 @@ class Bench:
     steps_per_run: int
     device: str
     share_training: bool
+    mix_eval_counts: bool = False
     report: dict = dataclasses.field(default_factory=dict, repr=False)  # the suite's (kagec suite)
 
     def table(self) -> List[List[tasks.Job]]:
-        return tasks.task_table(self.units, self.seeds, self.pack, self.out)
+        return tasks.task_table(self.units, self.seeds, self.pack, self.out, self.mix_eval_counts)
 
     def run_command(self) -> List[str]:
         """`python3 -m kage.bench run` with this benchmark's arguments (append --task I)."""
         pairs = ["--pairs", *self.pairs] if self.pairs else []
         return [sys.executable, "-m", "kage.bench", "run", self.suite, "--seeds", self.seeds_text, "--out", self.out,
                 "--pack", str(self.pack), *pairs, *(["--share-training"] if self.share_training else []),
-                *self.trainer_args]
+                *(["--mix-eval-counts"] if self.mix_eval_counts else []), *self.trainer_args]
 
 
 def add_bench_arguments(parser: argparse.ArgumentParser) -> None:
@@ -305,6 +307,9 @@ def add_bench_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--pack", type=int, default=1, help="train K runs at once in one process (default 1)")
     parser.add_argument("--share-training", action="store_true",
                         help="train pairs that share a train config once per seed, evaluating all their eval configs")
+    parser.add_argument("--mix-eval-counts", action="store_true",
+                        help="pack runs that evaluate different numbers of configs together, in manifest order "
+                             "(the evaluation pads each to the pack's most), so that tasks can end together")
 
 
 def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
@@ -346,7 +351,8 @@ def plan(args: argparse.Namespace, trainer_args: List[str]) -> Bench:
         if not p["certified"] and any(p["pair"] == q["pair"] for u in units for q in u.pairs):
             print(f"kage.bench: warning: {p['pair']} is not certified: {'; '.join(p['problems'])}", file=sys.stderr)
     return Bench(suite, out, args.seeds, args.pairs, args.pack, trainer_args, units, seeds,
-                 probe.num_iterations * probe.batch_size, probe.device, args.share_training, report)
+                 probe.num_iterations * probe.batch_size, probe.device, args.share_training, args.mix_eval_counts,
+                 report)
 
 
 def check_before_runs(probe, units) -> None:
@@ -472,7 +478,7 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
             os.makedirs(job[2], exist_ok=True)
             pending.append(job)
     failures = []
-    for index, pack in enumerate(packs_of(pending, bench.pack)):
+    for index, pack in enumerate(packs_of(pending, bench.pack, bench.mix_eval_counts)):
         labels = [f"{u.name} seed {s}" for u, s, _ in pack]
         run_dirs = [d for _, _, d in pack]
         if len(pack) == 1:

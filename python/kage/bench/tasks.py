@@ -15,14 +15,16 @@ def run_dir(out: str, unit_name: str, seed: int) -> str:
     return os.path.join(out, "runs", unit_name, f"seed_{seed}")
 
 
-def task_table(units: Sequence, seeds: Sequence[int], pack: int, out: str) -> List[List[Job]]:
-    """Runs that evaluate the same number of configs share tasks (a pack's evaluation pads each run to its runs'
-    most configs, kage.ppo.evaluation, which this layout never needs); within that, manifest order, seeds
-    innermost."""
+def task_table(units: Sequence, seeds: Sequence[int], pack: int, out: str,
+               mix_eval_counts: bool = False) -> List[List[Job]]:
+    """Runs that evaluate the same number of configs share tasks, unless `mix_eval_counts` (--mix-eval-counts: a
+    pack's evaluation pads each run to its runs' most configs, kage.ppo.evaluation, so that tasks of K runs in
+    manifest order can end together); within that, manifest order, seeds innermost."""
     groups: Dict[int, List[Job]] = {}
     for unit in units:
         for seed in seeds:
-            groups.setdefault(len(unit.evals), []).append((unit, seed, run_dir(out, unit.name, seed)))
+            count = 0 if mix_eval_counts else len(unit.evals)
+            groups.setdefault(count, []).append((unit, seed, run_dir(out, unit.name, seed)))
     return [group[i:i + pack] for group in groups.values() for i in range(0, len(group), pack)]
 
 
