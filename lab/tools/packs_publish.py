@@ -8,28 +8,25 @@ removing it first, on purpose.
 
 usage: python3 lab/tools/packs_publish.py FROM DEST --note NOTE"""
 import argparse
-import hashlib
 import os
 import re
 import sys
 import tarfile
 import tempfile
 
+from pack_task import BUNDLE, sha256  # the packs' one definition, beside this file
+from table_unpack import read_sums
+
 TASK_FILE = re.compile(r"^task_(\d+)\.(tar\.gz|sha256)$")
-BUNDLE = "more_tasks.tar"
 
 
-def sha256(path: str) -> str:
-    with open(path, "rb") as f:
-        return hashlib.file_digest(f, "sha256").hexdigest()
-
-
-def listed_checksum(listing: str, archive_name: str, where: str) -> str:
-    """The checksum that the list gives the archive itself."""
-    for line in listing.splitlines():
-        if line.endswith(f"  {archive_name}") and not line.startswith("#"):
-            return line.split()[0]
-    sys.exit(f"packs_publish: {where}: no line for {archive_name}: not a list that pack_task.py wrote")
+def listed_checksum(listing_path: str, archive_name: str) -> str:
+    """The checksum that the list gives the archive itself, on its first line after the `#` lines."""
+    sums = read_sums(listing_path)
+    if not sums or sums[0][2] != archive_name:
+        sys.exit(f"packs_publish: {listing_path}: its first checksum is not {archive_name}'s: not a list that "
+                 "pack_task.py wrote")
+    return sums[0][1]
 
 
 def with_note(listing: str, note: str, where: str) -> str:
@@ -59,9 +56,9 @@ def publish_task(source: str, task: int, dest: str, note: str) -> str:
     archive, listing_path = (os.path.join(source, f"task_{task}.{ext}") for ext in ("tar.gz", "sha256"))
     if not os.path.exists(listing_path):
         sys.exit(f"packs_publish: {archive} came without its list, {listing_path}: copy both from the call's files")
+    wanted = listed_checksum(listing_path, f"task_{task}.tar.gz")
     with open(listing_path) as f:
         listing = f.read()
-    wanted = listed_checksum(listing, f"task_{task}.tar.gz", listing_path)
     found = sha256(archive)
     if found != wanted:
         sys.exit(f"packs_publish: {archive}: sha256 {found}, its list says {wanted}: the archive is damaged or "

@@ -91,13 +91,16 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
     specs = [env.resolved_specs[0]["config"] for env in flat_envs]  # the hidden game's: a mixture's configs share it
     episode_length = max(c["episode_length"] for c in specs)
     configs, n, num_actions = max(map(len, envs)), flat_envs[0].num_envs, flat_envs[0].single_action_space.n
-    # slot k * C + c: run k's c-th config, or padding (-1); a stream's draws depend on its own seed alone, so the
-    # padding's streams (seed 0) change no evaluation's actions.
-    slot_env = [c for run in envs for c in list(range(len(run))) + [-1] * (configs - len(run))]
-    real = [i for i, c in enumerate(slot_env) if c >= 0]
-    padded = len(real) < len(slot_env)
-    slot_seeds = iter(flat_seeds)
-    random = CounterRandom([next(slot_seeds) if c >= 0 else 0 for c in slot_env], device)
+    # Slot k * C + c holds run k's c-th config; a run's slots past its own configs are padding: blank frames, no
+    # environment, no result, and a sampling stream of seed 0, which changes no other's draws (a stream's values
+    # depend on its own seed alone).
+    slots = len(envs) * configs
+    real = [k * configs + c for k, run in enumerate(envs) for c in range(len(run))]
+    padded = len(real) < slots
+    slot_seeds = [0] * slots
+    for slot, seed in zip(real, flat_seeds):
+        slot_seeds[slot] = seed
+    random = CounterRandom(slot_seeds, device)
     counter = torch.zeros((), dtype=torch.int64, device=device)  # set by fill_: no host-to-device copy
     infos = []
     for env, seed in zip(flat_envs, flat_seeds):
@@ -106,15 +109,17 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
     streams.wait_for(env_streams)
     frames = [torch.from_dlpack(env.outputs()[0]) for env in flat_envs]
     if padded:
-        blank, by_env = torch.zeros_like(frames[0]), iter(frames)
-        frames = [next(by_env) if c >= 0 else blank for c in slot_env]
+        slot_frames = [torch.zeros_like(frames[0])] * slots
+        for slot, frame in zip(real, frames):
+            slot_frames[slot] = frame
+        frames = slot_frames
         real_slots = torch.tensor(real, device=device)
+        ended = torch.zeros((slots, n), device=device)  # the padding's rows stay 0: no episode ends there
     metrics = EpisodeMetrics(infos, [c["dist_to_success"] for c in specs], device)
 
     def slot_mask() -> torch.Tensor:
-        """The episodes that just ended, [K * C, E]: none in the padding."""
-        mask = metrics.mask()
-        return torch.zeros((len(slot_env), n), device=device).index_copy_(0, real_slots, mask) if padded else mask
+        """The episodes that just ended, [K * C, E]."""
+        return ended.index_copy_(0, real_slots, metrics.mask()) if padded else metrics.mask()
 
     stack = FrameStack(torch.stack(frames)) if settings.frame_stack else None
     episodes = settings.episodes
@@ -127,7 +132,7 @@ def evaluate(agent, envs: List[List["kage.VecEnv"]], seeds: List[List[int]],
         actions, _, _ = policy_step(agent, obs.view(len(envs), configs * n, *obs.shape[2:]),
                                     uniform.reshape(len(envs), configs * n, num_actions),
                                     bf16=settings.bf16, greedy=settings.greedy)
-        actions = actions.view(len(slot_env), n)
+        actions = actions.view(slots, n)
         kage.step_batches(flat_envs, actions.index_select(0, real_slots) if padded else actions)
         streams.wait_for(env_streams)
         if stack:
