@@ -11,7 +11,7 @@ from kage.ppo import checkpoint, loop_state, rundir, train
 from kage.ppo.checkpoint_writer import CheckpointWriter
 from support import NEAR_GOAL_RUNS
 
-SLOW_ENCODE_S = 0.6  # several iterations of this run on a CPU: training goes on while a checkpoint is written
+HOLD_TIMEOUT_S = 120  # far longer than an iteration of this pack on a loaded CPU machine
 FLAGS = ["--device", "cpu", "--threads", "1", "--total-timesteps", "160", "--num-envs", "2", "--num-steps", "16",
          "--num-minibatches", "2", "--update-epochs", "2", "--run-eval-every", "2", "--eval-episodes", "2",
          "--eval-num-envs", "2", "--save-checkpoint-every", "1", "--normalize-reward"]
@@ -43,25 +43,27 @@ def test_a_checkpoint_holds_the_runs_as_they_were_when_asked_for(tmp_path, monke
     stopped = [checkpoint.load(tmp_path / f"stopped/seed_{run['seed']}/checkpoints/latest.pt") for run in NEAR_GOAL_RUNS]
     assert [c["iteration"] for c in stopped] == [2, 2]
 
-    # The same pack to the end, each checkpoint's encoding slowed so that later iterations train meanwhile.
-    encode, log, written, logged, trained_meanwhile = checkpoint.encode, rundir.RunDir.log, {}, [], []
+    # The same pack to the end, iteration 2's checkpoint held until the pack has logged iteration 3: a writer that
+    # held up training would wait out the timeout and fail the test, not hang it.
+    encode, log, written = checkpoint.encode, rundir.RunDir.log, {}
+    iteration_3_logged, trained_meanwhile = threading.Event(), []
 
-    def slow_encode(state):
-        rows_before = len(logged)
-        threading.Event().wait(SLOW_ENCODE_S)
-        trained_meanwhile.append(len(logged) > rows_before)
+    def held_encode(state):
+        if state["iteration"] == 2:
+            trained_meanwhile.append(iteration_3_logged.wait(timeout=HOLD_TIMEOUT_S))
         data = encode(state)
         written.setdefault(state["agent_spec"]["seed"], {})[state["iteration"]] = data
         return data
 
-    def counted_log(self, row):
-        logged.append(row)
+    def watched_log(self, row):
+        if row["iteration"] >= 3:
+            iteration_3_logged.set()
         return log(self, row)
 
-    monkeypatch.setattr(rundir.checkpoint, "encode", slow_encode)
-    monkeypatch.setattr(rundir.RunDir, "log", counted_log)
+    monkeypatch.setattr(rundir.checkpoint, "encode", held_encode)
+    monkeypatch.setattr(rundir.RunDir, "log", watched_log)
     train.train(pack_args(tmp_path / "whole"))
-    assert any(trained_meanwhile), "no checkpoint was written while training went on"
+    assert trained_meanwhile == [True, True], "iteration 2's checkpoint was not written while training went on"
     for run, reference in zip(NEAR_GOAL_RUNS, stopped):
         assert sorted(written[run["seed"]]) == [1, 2, 3, 4, 5]
         at_2 = tmp_path / f"seed_{run['seed']}_iteration_2.pt"
