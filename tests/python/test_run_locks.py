@@ -132,12 +132,12 @@ def test_a_reused_process_id_is_not_the_holder(tmp_path):
         held.acquire("")
 
 
-def racer(directory, barrier, results):
+def racer(directory, barrier, results, all_tried):
     barrier.wait()
     try:
         lock.DirectoryLock(directory, "run", "racer").acquire("")
         results.put(os.getpid())
-        time.sleep(2)  # hold it while the others try
+        all_tried.wait(timeout=60)  # hold it until every racer has tried, however slowly they are scheduled
     except lock.LockHeld:
         results.put(None)
 
@@ -147,11 +147,14 @@ def test_of_eight_racing_processes_exactly_one_gets_the_lock(tmp_path, dead_firs
     if dead_first:
         plant(tmp_path, {"host": "elsewhere", "pid": 1, "token": "old"}, age_s=lock.STALE_S + 60)
     context = multiprocessing.get_context("fork")
-    barrier, results = context.Barrier(8), context.Queue()
-    racers = [context.Process(target=racer, args=(str(tmp_path), barrier, results)) for _ in range(8)]
+    barrier, results, all_tried = context.Barrier(8), context.Queue(), context.Event()
+    racers = [context.Process(target=racer, args=(str(tmp_path), barrier, results, all_tried)) for _ in range(8)]
     for r in racers:
         r.start()
-    won = [results.get(timeout=60) for _ in racers]
+    try:
+        won = [results.get(timeout=60) for _ in racers]
+    finally:
+        all_tried.set()
     for r in racers:
         r.join()
     assert sum(w is not None for w in won) == 1, won
