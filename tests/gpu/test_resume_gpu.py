@@ -3,7 +3,6 @@ the resumed run loads the Adam state onto the device, continues the step count, 
 run's log rows and parameters, bit for bit. The runs use cuDNN's deterministic algorithms: under the trainer's
 default autotuned ones, two uninterrupted runs already differ by up to 8e-5 in fc_weight after 16 Adam steps
 (H100, 2026-11-26), as much as a resumed run does, so no tolerance could tell a faulty resume from rounding."""
-import pytest
 import torch
 
 from kage.ppo import checkpoint, train
@@ -13,15 +12,6 @@ from test_train_resume import rows
 FLAGS = ["--train-config-path", str(CONFIGS / "near_goal.yaml"), "--seed", "3", "--device", "cuda",
          "--total-timesteps", "2048", "--num-envs", "8", "--num-steps", "64", "--num-minibatches", "2",
          "--update-epochs", "2", "--run-eval-every", "0", "--save-checkpoint-every", "2"]
-
-
-@pytest.fixture
-def deterministic(monkeypatch):
-    monkeypatch.setattr(torch.backends.cudnn, "deterministic", True)
-    before = torch.are_deterministic_algorithms_enabled(), torch.is_deterministic_algorithms_warn_only_enabled()
-    torch.use_deterministic_algorithms(True, warn_only=True)  # a warning names any op without such an algorithm
-    yield
-    torch.use_deterministic_algorithms(before[0], warn_only=before[1])
 
 
 def run(out, stop_after=None):

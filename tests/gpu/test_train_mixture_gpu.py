@@ -21,15 +21,6 @@ FLAGS = dict(device=DEVICE, bf16=True, fused_input=True, cuda_graph=True, triton
              eval_num_envs=4, save_checkpoint_every=1)
 
 
-@pytest.fixture
-def deterministic(monkeypatch):
-    monkeypatch.setattr(torch.backends.cudnn, "deterministic", True)
-    before = torch.are_deterministic_algorithms_enabled(), torch.is_deterministic_algorithms_warn_only_enabled()
-    torch.use_deterministic_algorithms(True, warn_only=True)
-    yield
-    torch.use_deterministic_algorithms(before[0], warn_only=before[1])
-
-
 def assert_same_runs(a: train.Args, b: train.Args) -> None:
     """Run b logged what run a did and ended with its parameters."""
     ra, rb = rows(pathlib.Path(a.out)), rows(pathlib.Path(b.out))
