@@ -58,10 +58,11 @@ def published(methods_root: str) -> List[str]:
                   and any(f.endswith(".tar.gz") for f in os.listdir(os.path.join(methods_root, name, "packs"))))
 
 
-def compared(dirs: List[str], names: List[str], out: str) -> dict:
-    """compare.json of `kage.bench compare DIRS --names NAMES --seeds 1-5 --reps REPS --out OUT`."""
+def compared(dirs: List[str], names: List[str], out: str, cache: dict) -> dict:
+    """compare.json of `kage.bench compare DIRS --names NAMES --seeds 1-5 --reps REPS --out OUT`, each directory
+    read once for all the compares that share `cache`."""
     try:
-        return compare(dirs, names, out, reps=REPS, seeds=SEEDS)
+        return compare(dirs, names, out, reps=REPS, seeds=SEEDS, cache=cache)
     except SystemExit as e:  # compare's refusal, naming the methods it was comparing
         fail(f"{names[0]} against {names[1]}: {e}")
 
@@ -181,22 +182,23 @@ def computed(methods: List[str], methods_root: str, baseline_packs: str, work: s
     unpack_all(baseline_packs, baseline_dir, say=lambda line: None)
     costs = {BASELINE: (gpu_time(baseline_dir), devices(baseline_packs))}
     results, method_dirs = {}, {method: os.path.join(work, "methods", method) for method in methods}
+    cache: dict = {}  # every directory read once (kage.bench.compare.load_once)
     for method, method_dir in method_dirs.items():
         unpack_all(os.path.join(methods_root, method, "packs"), method_dir, say=lambda line: None)
         costs[method] = (gpu_time(method_dir), devices(os.path.join(methods_root, method, "packs")))
         print(f"methods_tables: comparing {method} with the {BASELINE}", file=sys.stderr)
         results[method] = compared([method_dir, baseline_dir], [method, BASELINE],
-                                   os.path.join(work, "compare", method))
+                                   os.path.join(work, "compare", method), cache)
     matches = {}
     for i, a in enumerate(methods):
         for b in methods[i + 1:]:
             print(f"methods_tables: comparing {a} with {b}", file=sys.stderr)
             matches[(a, b)] = compared([method_dirs[a], method_dirs[b]], [a, b],
-                                       os.path.join(work, "compare", f"{a}-{b}"))
+                                       os.path.join(work, "compare", f"{a}-{b}"), cache)
     full = next((r for r in results.values() if covers_all(r)), None)
     if full is None:  # no method has every pair and seed: the baseline's row comes from itself
         full = compared([baseline_dir, baseline_dir], [BASELINE, f"{BASELINE} again"],
-                        os.path.join(work, "compare", BASELINE))
+                        os.path.join(work, "compare", BASELINE), cache)
     return tables(full, results, matches, costs)
 
 

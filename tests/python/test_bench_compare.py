@@ -90,6 +90,21 @@ def test_three_methods_give_each_two(two, tmp_path):
     assert "P(base > mine)" in (a / "compare" / "compare.md").read_text()
 
 
+def test_a_cache_reads_each_directory_once_and_keeps_it_unchanged(two, tmp_path):
+    a, b = two
+    everything = compare.compare([str(a), str(b)], out_dir=str(tmp_path / "plain"), reps=500)
+    cache = {}
+    compare.compare([str(a), str(b)], out_dir=str(tmp_path / "first"), reps=500, seeds=[1, 2], cache=cache)
+    for d in (a, b):
+        shutil.rmtree(d / "runs")  # a compare that read them again would now refuse the directories
+    again = compare.compare([str(a), str(b)], out_dir=str(tmp_path / "again"), reps=500, cache=cache)
+    # the first compare's seeds 1 and 2 changed its copies only: all three seeds, as without a cache
+    assert {**again, "out_dir": None} == {**everything, "out_dir": None}
+    renamed = compare.compare([str(b), str(a)], names=["B2", "A2"], out_dir=str(tmp_path / "renamed"), reps=500,
+                              cache=cache)
+    assert [m["name"] for m in renamed["methods"]] == ["B2", "A2"]
+
+
 # ---- refusals ----
 
 def test_a_method_may_train_otherwise_but_must_evaluate_alike(two):

@@ -38,6 +38,7 @@ improvement.csv (P(X > Y) per axis and pair of methods), compare.json (everythin
 plots/profile_<metric>.png.
 """
 import argparse
+import copy
 import dataclasses
 import difflib
 import json
@@ -130,6 +131,17 @@ def load(bench_dir: str, name: str, protocol: str, max_step: Optional[int] = Non
                   runs, {(r["pair"], r["seed"]) for r in levels["runs"]},
                   {p["pair"]: p for p in suite["pairs"] if p["pair"] in ran},
                   trainer_flags=list(bench.get("trainer_args") or []))
+
+
+def load_once(cache: Optional[dict], bench_dir: str, name: str, protocol: str, max_step: Optional[int]) -> Method:
+    """load, or a copy of what an earlier compare with the same `cache` loaded from the directory: reading its runs'
+    logs is most of a compare's time, and a caller comparing one directory with many others reads it once."""
+    if cache is None:
+        return load(bench_dir, name, protocol, max_step)
+    key = (os.path.realpath(bench_dir), protocol, max_step)
+    if key not in cache:
+        cache[key] = load(bench_dir, name, protocol, max_step)
+    return dataclasses.replace(copy.deepcopy(cache[key]), name=name)  # compare changes its methods: never the cached
 
 
 def choose_seeds(methods: List[Method], wanted: Optional[List[int]]) -> List[int]:
@@ -454,10 +466,11 @@ def method_names(dirs: List[str], names: Optional[List[str]]) -> List[str]:
 def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optional[str] = None,
             protocol: str = "max", reps: int = intervals.REPS, metric: str = SUCCESS_SHOWN,
             seeds: Optional[List[int]] = None, pairs: Optional[List[str]] = None,
-            max_step: Optional[int] = None) -> dict:
+            max_step: Optional[int] = None, cache: Optional[dict] = None) -> dict:
     """Compares the benchmark directories `dirs` (see the module's docstring) on `seeds` (--seeds), `pairs`
     (--pairs) and up to step `max_step` (--max-step) where given, writes the tables and plots into `out_dir`
-    (default dirs[0]/compare) and returns compare.json's content."""
+    (default dirs[0]/compare) and returns compare.json's content. `cache`: a dict kept between calls that compare
+    the same directories again, unchanged in between (load_once)."""
     if len(dirs) < 2:
         fail("give two or more benchmark directories")
     if protocol not in report.PROTOCOLS:
@@ -468,7 +481,7 @@ def compare(dirs: List[str], names: Optional[List[str]] = None, out_dir: Optiona
         fail(intervals.reps_problem(reps))
     if max_step is not None and (not isinstance(max_step, int) or isinstance(max_step, bool) or max_step <= 0):
         fail(f"--max-step takes a number of steps above 0, not {max_step!r}")
-    methods = [load(d, name, protocol, max_step) for d, name in zip(dirs, method_names(dirs, names))]
+    methods = [load_once(cache, d, name, protocol, max_step) for d, name in zip(dirs, method_names(dirs, names))]
     chosen_seeds = choose_seeds(methods, seeds)
     chosen_pairs = choose_pairs(methods, pairs)
     check_pairs(methods, chosen_pairs)
