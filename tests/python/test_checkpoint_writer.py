@@ -7,7 +7,7 @@ import threading
 import pytest
 import torch
 
-from kage.ppo import checkpoint, loop_state, rundir, train
+from kage.ppo import checkpoint, rundir, train
 from kage.ppo.checkpoint_writer import CheckpointWriter
 from support import NEAR_GOAL_RUNS
 
