@@ -13,6 +13,9 @@ launcher=()
 if command -v ccache >/dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=1
+  # build/'s compiler by the same name (ccache hashes it: /usr/bin/c++ for build/'s /usr/bin/g++ matched no object).
+  compiler=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' build/CMakeCache.txt 2>/dev/null)
+  [[ -n $compiler ]] && launcher+=(-DCMAKE_CXX_COMPILER="$compiler")
 fi
 mkdir -p "$build"
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DKAGE_CUDA=OFF -DPython_EXECUTABLE="$python" \
