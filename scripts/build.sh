@@ -26,7 +26,7 @@ fi
 
 # The CUDA toolkit is optional: with it (and NVRTC's header, which the venv's nvidia-cuda-nvrtc wheel
 # carries), the GPU backend is compiled and checked too.
-if [[ -z ${CUDACXX:-} && -x /usr/local/cuda/bin/nvcc ]]; then export CUDACXX=/usr/local/cuda/bin/nvcc; fi
+source scripts/cuda_compiler.sh
 python=$(scripts/venv.sh)
 build=${BUILD:-build}
 # ccache shares object files between build folders (build/, the KAGE_CUDA=OFF build, a fresh clone's).

@@ -20,12 +20,11 @@ step git clone -q "$repo" "$work/clone"
 step python3 -m venv "$work/venv"
 step "$work/venv/bin/pip" install -q -c "$repo/scripts/constraints.txt" nvidia-cuda-nvrtc gymnasium
 # ccache, where build.sh's builds filled it, with paths relative to the clone so its objects match: the build
-# folder inside the clone as build.sh's is inside the repository, and the CUDA toolkit by build.sh's path (CMake
-# finds it as /usr/local/cuda-13.0 otherwise, where build.sh's compile commands name /usr/local/cuda).
+# folder inside the clone as build.sh's is inside the repository, and the CUDA toolkit by build.sh's path.
 if command -v ccache >/dev/null; then
   export CMAKE_CXX_COMPILER_LAUNCHER=ccache CCACHE_BASEDIR=$work/clone CCACHE_NOHASHDIR=1
   export SKBUILD_BUILD_DIR=$work/clone/build
-  if [[ -z ${CUDACXX:-} && -x /usr/local/cuda/bin/nvcc ]]; then export CUDACXX=/usr/local/cuda/bin/nvcc; fi
+  source scripts/cuda_compiler.sh
 fi
 export CMAKE_BUILD_PARALLEL_LEVEL=$(nproc)
 step "$work/venv/bin/pip" install -q "$work/clone"
