@@ -36,18 +36,26 @@
 # which must stay under the device's 64 MiB: the published run data outgrow that, so move every results/ folder
 # (but PUBLISHED) out of the working tree for the lease's calls (the deletions are not committed) and back
 # afterwards.
+# Two suites or methods share a lease of several GPUs as two runners, each with its GPUS, DIR and a folder of the
+# call's $OUT (OUT=$OUT/NAME; MAX_FILES split between them, 8 in all), started side by side in each call.
 # Run with carry [".deps"]:
 #   COMMIT=$(git rev-parse --short HEAD) GPUS=all PACK=6 bash lab/tools/table_device.sh
 #   COMMIT=... TASK=0 PACK=6 bash lab/tools/table_device.sh
+#   C="COMMIT=... SEEDS=1-5 PACK=5 LIMIT=570"; env $C OUT=$OUT/a MAX_FILES=4 GPUS=0,1 TASKS=3,4 DIR=/tmp/a
+#     FLAGS="..." bash lab/tools/table_device.sh >/dev/null & env $C OUT=$OUT/b MAX_FILES=4 GPUS=2,3 TASKS=4,5
+#     SUITE=kage_bench_loo DIR=/tmp/b FLAGS="..." bash lab/tools/table_device.sh; wait; tail -20 $OUT/a/call.log
 set -uo pipefail
 if [ -n "${GPUS:-}" ]; then scope=(--gpus "$GPUS" ${TASKS:+--tasks "$TASKS"}); else scope=(--task "${TASK:?GPUS=all or TASK=I}"); fi
 : "${COMMIT:?COMMIT=<the commit of this tree>: recorded in the checksum list of each pack}"
 ROOT=${ROOT:-/tmp/kage-table-tree}
+# Two runners started side by side (their own DIR and OUT) copy and build one at a time: the second finds it done.
+exec 9>"$ROOT.lock" && flock 9 || exit 1
 if [ ! -e "$ROOT/.copied" ]; then
   rm -rf "$ROOT" && mkdir -p "$ROOT" && cp -a . "$ROOT" && touch "$ROOT/.copied" || exit 1
 fi
 cd "$ROOT" || exit 1
 source lab/tools/device_build.sh  # incremental: builds once a lease, since ROOT does not change
+flock -u 9 && exec 9>&-
 cat "$OUT/gpu.txt" >"$OUT/call.log" && rm -f "$OUT/gpu.txt" "$OUT/build.log"  # one log file: the build passed
 PACK=${PACK:-6}
 DIR=${DIR:-/tmp/kage-table}
