@@ -278,7 +278,9 @@ class Converter {
       DocEntry e;
       const uint32_t kb = offset_of(it->first, begin);
       e.key = it->first.IsScalar() ? utf8_from_latin1_strays(it->first.Scalar()) : std::string("?");
-      e.key_range = Range{Loc{file_, kb}, kb + static_cast<uint32_t>(e.key.size())};
+      // Clamped: an empty explicit key (`?` alone) is a null node marked at the end of the file.
+      e.key_range = Range{Loc{file_, kb},
+                          std::min(kb + static_cast<uint32_t>(e.key.size()), static_cast<uint32_t>(text_.size()))};
       const std::string key_tag = it->first.Tag();
       const TagKind key_kind = classify_tag(key_tag);
       if (key_kind == TagKind::Merge || (key_tag == "?" && it->first.IsScalar() && e.key == "<<")) {

@@ -287,4 +287,20 @@ TEST_CASE("control characters YAML forbids are refused where they are", "[yaml][
   CHECK(std::get<std::string>(scalar_value(at(*ok.doc, "b"))) == std::string("x\0y", 3));
 }
 
+TEST_CASE("a key that is not a name is located inside the file", "[yaml][hostile]") {
+  // `?` alone is an explicit key with no content: a null node that yaml-cpp marks at the end of the file,
+  // once past it (a fuzz input). PyYAML loads it as {None: None}, which the original ignores.
+  for (const std::string text : {"?\n", "physics:\n  gravity: 0.5\n?\n", "a: 1\n?  # empty\n"}) {
+    Parsed p;
+    parse(p, text);
+    INFO(text << "\n" << p.dump());
+    REQUIRE(p.doc);
+    const DocEntry& last = p.doc->entries.back();
+    CHECK(last.key == "?");
+    CHECK(last.key_range.begin.offset <= last.key_range.end);
+    CHECK(last.key_range.end <= text.size());
+    CHECK(last.value.range.end <= text.size());
+  }
+}
+
 }  // namespace kage::test
