@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -274,11 +275,13 @@ class Converter {
     std::map<std::string, Range> seen;
     std::vector<DocEntry> merged;  // the entries of the merged mappings, in PyYAML's order
     bool has_merge = false;
+    uint32_t previous_end = begin;  // the end of the entry before, where the text up to the next key starts
     for (auto it = n.begin(); it != n.end(); ++it) {
       DocEntry e;
-      const uint32_t kb = offset_of(it->first, begin);
+      const uint32_t mark = offset_of(it->first, begin);
+      const uint32_t kb = it->first.IsNull() ? explicit_key_indicator(previous_end, mark) : mark;
       e.key = it->first.IsScalar() ? utf8_from_latin1_strays(it->first.Scalar()) : std::string("?");
-      // Clamped: an empty explicit key (`?` alone) is a null node marked at the end of the file.
+      // Clamped: an empty explicit key (`?` alone) at the end of the file is a null node marked at its end.
       e.key_range = Range{Loc{file_, kb},
                           std::min(kb + static_cast<uint32_t>(e.key.size()), static_cast<uint32_t>(text_.size()))};
       const std::string key_tag = it->first.Tag();
@@ -286,6 +289,7 @@ class Converter {
       if (key_kind == TagKind::Merge || (key_tag == "?" && it->first.IsScalar() && e.key == "<<")) {
         has_merge = true;
         add_merged(convert(it->second, e.key_range.end, pointer + "/<<"), e.key_range, merged);
+        previous_end = e.key_range.end;
         continue;
       }
       if (key_kind != TagKind::None && key_kind != TagKind::Str)
@@ -301,6 +305,7 @@ class Converter {
                                       "duplicate key '" + e.key + "'; remove one of the two", pointer + "/" + e.key);
         d.notes.push_back({prev->second.begin, "first given here (the original would silently use the last one)"});
       }
+      previous_end = std::max(e.key_range.end, e.value.range.end);
       out.entries.push_back(std::move(e));
     }
     out.range.end = out.entries.empty() ? begin + 1 : out.entries.back().value.range.end;
@@ -416,6 +421,22 @@ class Converter {
     out.kind = DocNode::Kind::Scalar;
     out.text = *plain;
     out.quoted = false;
+  }
+
+  // An empty explicit key (`?` alone) is a null node that yaml-cpp marks at the next token: the `?` written
+  // between `from` (the end of the entry before) and that mark, outside comments; else the mark.
+  uint32_t explicit_key_indicator(uint32_t from, uint32_t mark) const {
+    const auto space = [this](size_t i) { return i >= text_.size() || std::isspace(static_cast<unsigned char>(text_[i])); };
+    bool comment = false;
+    for (uint32_t i = from; i < mark && i < text_.size(); ++i) {
+      if (text_[i] == '\n')
+        comment = false;
+      else if (!comment && text_[i] == '#' && (i == 0 || space(i - 1)))
+        comment = true;
+      else if (!comment && text_[i] == '?' && space(i + 1))
+        return i;
+    }
+    return mark;
   }
 
   uint32_t offset_of(const YAML::Node& n, uint32_t fallback) const {

@@ -3,6 +3,7 @@
 // typed by the YAML 1.1 rules. Each expected value was worked out with PyYAML 6 by hand.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "compiler/analysis/suite.h"
@@ -287,20 +288,44 @@ TEST_CASE("control characters YAML forbids are refused where they are", "[yaml][
   CHECK(std::get<std::string>(scalar_value(at(*ok.doc, "b"))) == std::string("x\0y", 3));
 }
 
-TEST_CASE("a key that is not a name is located inside the file", "[yaml][hostile]") {
-  // `?` alone is an explicit key with no content: a null node that yaml-cpp marks at the end of the file,
-  // once past it (a fuzz input). PyYAML loads it as {None: None}, which the original ignores.
-  for (const std::string text : {"?\n", "physics:\n  gravity: 0.5\n?\n", "a: 1\n?  # empty\n"}) {
+TEST_CASE("an empty explicit key is located at its '?'", "[yaml][hostile]") {
+  // `?` alone is an explicit key with no content: a null node that yaml-cpp marks at the next token, or at the
+  // end of the file, once past it (a fuzz input). PyYAML loads it as {None: None}, which the original ignores.
+  struct Case {
+    std::string text;
+    uint32_t line, col;  // of the `?`
+  };
+  const Case cases[] = {
+      {"?\n", 1, 1},
+      {"physics:\n  gravity: 0.5\n?\n", 3, 1},
+      {"a: 1\n?  # empty\n", 2, 1},
+      {"seed: 1 # why? no\n?\nH: 64\n", 2, 1},  // a `?` in a comment is not the key
+      {"title: what?\n? # empty\n", 2, 1},       // nor one in the value before
+      {"{seed: 1, ? , H: 64}\n", 1, 11},
+  };
+  for (const Case& c : cases) {
     Parsed p;
-    parse(p, text);
-    INFO(text << "\n" << p.dump());
+    parse(p, c.text);
+    INFO(c.text << "\n" << p.dump());
     REQUIRE(p.doc);
-    const DocEntry& last = p.doc->entries.back();
-    CHECK(last.key == "?");
-    CHECK(last.key_range.begin.offset <= last.key_range.end);
-    CHECK(last.key_range.end <= text.size());
-    CHECK(last.value.range.end <= text.size());
+    const auto key = std::find_if(p.doc->entries.begin(), p.doc->entries.end(),
+                                  [](const DocEntry& e) { return e.key == "?"; });
+    REQUIRE(key != p.doc->entries.end());
+    const LineCol at = p.sources.line_col(key->key_range.begin);
+    CHECK(at.line == c.line);
+    CHECK(at.col == c.col);
+    CHECK(key->key_range.end <= c.text.size());
+    CHECK(key->value.range.end <= c.text.size());
   }
+  // Nested, the `?` is found after the entry before it in its own mapping.
+  Parsed nested;
+  parse(nested, "physics:\n  gravity: 0.5\n  ?\n  ground_friction: 0.8\n");
+  REQUIRE(nested.doc);
+  const DocEntry& physics = nested.doc->entries.front();
+  REQUIRE(physics.value.entries.size() == 3);
+  const LineCol at = nested.sources.line_col(physics.value.entries[1].key_range.begin);
+  CHECK(at.line == 3);
+  CHECK(at.col == 3);
 }
 
 }  // namespace kage::test
