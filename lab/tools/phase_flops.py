@@ -2,7 +2,7 @@
 FLOPs per frame (its layers' shapes on the spec's 128 x 128 x 3 frames), the frames each phase passes (the
 rollout's forward pass one a step, the update's forward and backward passes `update_epochs` a step), and so the
 TFLOP/s each phase reached; then what a target rate with evaluations asks of them: the longest iteration it
-allows (`kage.bench speed`'s run of 25 M steps with 32 evaluation points at the row's evaluation point) and the
+allows (in the run of 25 M steps that the row's rate with evaluations describes, its evaluations as long) and the
 TFLOP/s the network's passes must then average, with the other phases (environment, augmentation, optimizer,
 other) as measured. Issue 38's 500 k is the default target. The rollout's bootstrap values (one forward a pack's
 environment an iteration, under 1 % of its frames) are not counted.
@@ -44,7 +44,7 @@ def phase_work(row: dict, args: Args, target: float, forward: int, backward: int
     """Per network phase of the row: its seconds, TFLOP and TFLOP/s (`forward`, `backward`: FLOPs a frame); and
     the target's iteration bound."""
     iteration = row["iteration_s"]
-    steps = row["K"] * args.batch_size
+    steps = row["steps_per_s"] * iteration  # an iteration's: K runs' batches
     frames = {"forward": steps, "update_forward": steps * args.update_epochs, "backward": steps * args.update_epochs}
     flops = {"forward": forward, "update_forward": forward, "backward": backward}
     phases = {}
@@ -52,9 +52,12 @@ def phase_work(row: dict, args: Args, target: float, forward: int, backward: int
         seconds = row["shares"][phase] * iteration
         tflop = frames[phase] * flops[phase] / 1e12
         phases[phase] = {"s": seconds, "tflop": tflop, "tflops": tflop / seconds}
-    # kage.bench speed: a run of num_iterations iterations and 32 evaluation points at the row's eval point.
-    run_steps = steps * args.num_iterations
-    bound = (run_steps / target - 32 * row["eval_point_s"]) / args.num_iterations
+    # The run whose rate with evaluations the row gives: its iterations, and its evaluations' seconds beside them.
+    full_run = row["full_run_hours"] * 3600
+    run_steps = row["steps_per_s_with_evals"] * full_run
+    iterations = run_steps / steps
+    evaluations = full_run - iterations * iteration
+    bound = (run_steps / target - evaluations) / iterations
     rest = iteration * (1 - sum(row["shares"][p] for p in NETWORK_PHASES))
     network_tflop = sum(p["tflop"] for p in phases.values())
     needed = network_tflop / (bound - rest) if bound > rest else float("inf")
@@ -81,7 +84,7 @@ def main(argv: List[str]) -> int:
     parser.add_argument("speed", nargs="+", help="`kage.bench speed --json` files (one row a line)")
     parser.add_argument("--target", type=float, default=500_000, help="steps/s with evaluations (default 500 k)")
     options = parser.parse_args(argv)
-    args = Args()  # the spec's batch, epochs and run length, which kage.bench speed keeps
+    args = Args()  # the spec's update epochs, which kage.bench speed keeps
     forward, backward = network_flops()
     print(f"network: {forward / 1e6:.2f} MFLOP a frame forward, {backward / 1e6:.2f} backward")
     for path in options.speed:
