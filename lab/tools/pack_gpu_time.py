@@ -1,13 +1,13 @@
 """The GPU time of an unpacked benchmark directory, from its runs' own metrics: per pack (DIR/packs/task_I_pack_J.json,
-the runs one trainer process trained side by side on one GPU), the training seconds of its first run (the last
-iteration's global_step over its charts/SPS, which is the run's steps over its training time so far, resumes
-included) and its evaluation points' seconds (each point evaluates the whole pack at once, so every run of the pack
-logs the same seconds). The start of a pack (kernels compiled, batches opened) does not count. Packs trained before
-2086d34 count the host's time of each iteration only, not the device's unfinished work, the logging or the
-checkpoints (lab/2026-11-29-h200-train-clock); so each pack's wall time is given too: from its first run's run.json
-(written once the pack has opened) to its summary.json, as the files' times say (the packs' archives keep them), so
-that a pack resumed by a later process counts the time between. The devices are those the packs' checksum lists name
-(`# device:` lines)."""
+or task_I+K_pack_J.json of tasks trained as one: the runs one trainer process trained side by side on one GPU), the
+training seconds of its first run (the last iteration's global_step over its charts/SPS, which is the run's steps
+over its training time so far, resumes included) and its evaluation points' seconds (each point evaluates the whole
+pack at once, so every run of the pack logs the same seconds). The start of a pack (kernels compiled, batches
+opened) does not count. Packs trained before 2086d34 count the host's time of each iteration only, not the device's
+unfinished work, the logging or the checkpoints (lab/2026-11-29-h200-train-clock); so each pack's wall time is
+given too: from its first run's run.json (written once the pack has opened) to its summary.json, as the files' times
+say (the packs' archives keep them), so that a pack resumed by a later process counts the time between. The devices
+are those the packs' checksum lists name (`# device:` lines)."""
 import glob
 import json
 import os

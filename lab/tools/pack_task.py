@@ -19,6 +19,7 @@ usage: python3 lab/tools/pack_task.py DIR TASK|new DEST [MAX_FILES]"""
 import hashlib
 import json
 import os
+import re
 import shutil
 import sys
 import tarfile
@@ -30,6 +31,7 @@ TOP = ("bench.json", "suite.json", "tasks.json")
 LEFT_OUT = ("checkpoints", "tensorboard")
 LEFT_FOR_NEXT_CALL = 3
 BUNDLE = "more_tasks.tar"
+PACK_FILE = re.compile(r"^task_(\d+(?:\+\d+)*)_pack_\d+\.(?:json|log)$")
 
 
 def sha256(path: str) -> str:
@@ -80,6 +82,13 @@ def marked_done(root: str, runs: list) -> bool:
     return True
 
 
+def packed_tasks(pack_file: str) -> list:
+    """The tasks whose runs a pack file of DIR/packs holds: task_3_pack_0.log -> [3], and task_3+4_pack_0.log,
+    of tasks trained as one (kage.bench run --task 3+4), -> [3, 4], which both archives carry."""
+    match = PACK_FILE.match(pack_file)
+    return [int(task) for task in match.group(1).split("+")] if match else []
+
+
 def task_files(root: str, task: int) -> list:
     """The files to pack, relative to root; exits naming the unfinished runs if any."""
     table = task_table(root)
@@ -92,7 +101,7 @@ def task_files(root: str, task: int) -> list:
     files = [name for name in TOP if os.path.exists(os.path.join(root, name))]
     packs = os.path.join(root, "packs")
     if os.path.isdir(packs):
-        files += [os.path.join("packs", n) for n in sorted(os.listdir(packs)) if n.startswith(f"task_{task}_")]
+        files += [os.path.join("packs", n) for n in sorted(os.listdir(packs)) if task in packed_tasks(n)]
     for run in runs:
         for folder, dirs, names in os.walk(os.path.join(root, run)):
             dirs[:] = sorted(d for d in dirs if d not in LEFT_OUT)

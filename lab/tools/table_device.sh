@@ -3,7 +3,8 @@
 # runner, `kage.bench run SUITE --seeds SEEDS [--pairs PAIRS] --share-training --pack PACK` with the trainer flags
 # FLAGS (defaults: kage_bench, 1-10, every pair), trains in DIR on the machine's disk:
 # - GPUS=all (a machine of several GPUs): every task, one worker per GPU (`--gpus all`), or with TASKS=0,3 only
-#   those tasks (`--tasks`: what fits a lease, the others left for the next);
+#   those tasks (`--tasks`: what fits a lease, the others left for the next), TASKS=12+13 the two as one process
+#   and one pack of their runs (a GPU that a pack of 5 leaves idle), each packed as its own task;
 # - TASK=I: task I alone, on one GPU. Two runners side by side on one GPU train no faster together than one after
 #   the other (lab/2026-11-29-h200-drac-two-tasks), and a task must finish inside the lease (its checkpoints, 58 MB a
 #   run, cannot travel to the next): on one GPU, start the tasks that fit, one at a time.

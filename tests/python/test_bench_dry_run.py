@@ -48,6 +48,16 @@ def test_only_the_tasks_named(capsys, tmp_path, monkeypatch):
     assert gpu_lines[0].startswith("  GPU 0: task 4, weight 270") and gpu_lines[1].startswith("  GPU 1: task 3, ")
 
 
+def test_tasks_joined_by_plus_weigh_as_one(capsys, tmp_path, monkeypatch):
+    """--tasks 3+4 trains tasks 3 and 4 as one (one process, one pack): one GPU takes both, their weights summed."""
+    monkeypatch.chdir(tmp_path)
+    status, out = dry(capsys, "--pack", "12", "--gpus", "0,1", "--tasks", "0,3+4")
+    assert status == 0
+    gpu_lines = [line for line in out.splitlines() if line.startswith("  GPU ")]
+    assert gpu_lines[0].startswith("  GPU 0: task 3+4, weight 505 (100 % ")  # 235 + 270
+    assert gpu_lines[1].startswith("  GPU 1: task 0, weight 260 (51 % ")
+
+
 def test_the_gpus_are_named_as_given(capsys, tmp_path, monkeypatch):
     """--gpus 3,1 trains on GPUs 3 and 1 (the runner's [gpu 3] and [gpu 1]): the dry run names them so, in that
     order, the first taking the heaviest task."""
@@ -71,6 +81,7 @@ def test_hand_out_gives_each_task_to_the_first_free_worker():
 @pytest.mark.parametrize("extra, message", [
     (["--task", "0"], "--dry-run shows every task: drop --task"),
     (["--gpus", "0,1", "--tasks", "99"], "--tasks 99"),
+    (["--gpus", "0,1", "--tasks", "1+1"], "--tasks 1\\+1: the task table's indices are 0 to 34, each named once"),
 ])
 def test_refusals(capsys, tmp_path, monkeypatch, extra, message):
     monkeypatch.chdir(tmp_path)

@@ -62,8 +62,35 @@ def test_tasks_picks_what_the_gpus_train(tmp_path):
     assert (out / "runs" / PAIRS[1] / "seed_1" / "summary.json").exists()
 
 
+def test_tasks_joined_by_plus_train_as_one_pack(tmp_path):
+    """--tasks 0+2 trains tasks 0 and 2 in one process, one pack of both runs (packs/task_0+2_pack_0.json), on one
+    GPU; the runs land where each task's own would, and a rerun finds both finished."""
+    out = tmp_path / "bench"
+    args = ["run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out), *TINY_TRAINING]
+    first = bench(*args, "--gpus", "all", "--tasks", "0+2")
+    assert first.returncode == 0, first.stderr
+    assert "3 tasks, 0 finished earlier; 1 to train (of tasks 0+2) on GPUs 0,1" in first.stderr
+    assert "[gpu 0] task 0+2: background/1 seed 1, distractors/1 seed 1" in first.stderr
+    assert "2 runs in" in first.stderr
+    pack = json.loads((out / "packs" / "task_0+2_pack_0.json").read_text())
+    assert [run["out"] for run in pack["runs"]] == [str(out / "runs" / PAIRS[p] / "seed_1") for p in (0, 2)]
+    for pair in (PAIRS[0], PAIRS[2]):
+        state = json.loads((out / "runs" / pair / "seed_1" / "bench_state.json").read_text())
+        assert state["state"] == "done" and state["task"] == "0+2" and state["gpu"] == "0"
+    assert not (out / "runs" / PAIRS[1] / "seed_1" / "summary.json").exists()
+    assert (out / "tasks" / "task_0+2.log").exists() and not (out / "tasks" / "task_0.lock").exists()
+    again = bench(*args, "--gpus", "all", "--tasks", "2+0,1")
+    assert again.returncode == 0, again.stderr
+    assert "3 tasks, 2 finished earlier; 1 to train (of tasks 2+0,1)" in again.stderr
+
+
 @pytest.mark.parametrize("extra, message", [
     (["--gpus", "all", "--tasks", "3"], "--tasks 3: the task table of {out} has 3 tasks, 0 to 2, each named once"),
+    (["--gpus", "all", "--tasks", "0,1+0"], "--tasks 0,1+0: the task table of {out} has 3 tasks, 0 to 2, each named"),
+    (["--gpus", "all", "--tasks", "0+"], "--tasks 0+: use task indices like 0,3,4, or 3+4 to train tasks 3 and 4"),
+    (["--task", "3"], "--task 3: the task table of {out} has 3 tasks, 0 to 2, each named once (see tasks.json)"),
+    (["--task", "0,1"], "--task 0,1: one task (or tasks joined by '+', like 3+4); several tasks one after the other: "
+                        "--gpus all --tasks 3,4"),
     (["--gpus", "all", "--tasks", "1,1"], "--tasks 1,1: the task table of {out} has 3 tasks"),
     (["--gpus", "all", "--tasks", "one"], "--tasks one: use task indices like 0,3,4"),
     (["--tasks", "0"], "--tasks picks the tasks that --gpus trains: add --gpus all"),
@@ -159,5 +186,7 @@ def test_tasks_are_handed_out_longest_first():
                        2 * (2 + gpus.TRAINING_AS_CONFIGS), 6 * (6 + gpus.TRAINING_AS_CONFIGS),
                        6 * (6 + gpus.TRAINING_AS_CONFIGS)]
     # 252, 200, 84, 276, 276 at TRAINING_AS_CONFIGS = 40: tasks 3 and 4 tie (table order), then 0, 1 and 2
-    assert gpus.longest_first(table, [0, 1, 2, 3, 4]) == [3, 4, 0, 1, 2]
-    assert gpus.longest_first(table, [0, 2]) == [0, 2]
+    assert gpus.longest_first(table, gpus.every_task(table)) == [[3], [4], [0], [1], [2]]
+    assert gpus.longest_first(table, [[0], [2]]) == [[0], [2]]
+    # tasks joined by '+' weigh together: 1+2 (284) before 3 (276), 0 (252) last
+    assert gpus.longest_first(table, [[0], [3], [1, 2]]) == [[1, 2], [3], [0]]

@@ -171,3 +171,23 @@ def test_unpack_names_an_archive_that_is_not_a_task_s(tmp_path):
                             capture_output=True, text=True)
     assert result.returncode == 1
     assert f"{packs / 'task_1 (copy).tar.gz'}: not a task archive (task_I.tar.gz" in result.stderr
+
+
+def test_tasks_trained_as_one_carry_their_pack_in_each_archive(tmp_path):
+    """`kage.bench run --task 1+2` trains tasks 1 and 2 in one pack (packs/task_1+2_pack_0.*): both tasks' archives
+    carry its files, no other task's does, and the archives unpack side by side (the same files)."""
+    root = benchmark(tmp_path / "bench")
+    for suffix in ("json", "log"):
+        (root / f"packs/task_1+2_pack_0.{suffix}").write_text(f"the pack of tasks 1 and 2 ({suffix})\n")
+    (root / "packs/task_12_pack_0.log").write_text("another benchmark's task 12, had it one\n")
+    packs = tmp_path / "packs"
+    assert pack_new(root, packs, 8).returncode == 0
+    carried = {}
+    for task in range(3):
+        with tarfile.open(packs / f"task_{task}.tar.gz") as tar:
+            carried[task] = sorted(n for n in tar.getnames() if n.startswith("packs/"))
+    assert carried == {0: ["packs/task_0_pack_0.log"],
+                       1: ["packs/task_1+2_pack_0.json", "packs/task_1+2_pack_0.log"],
+                       2: ["packs/task_1+2_pack_0.json", "packs/task_1+2_pack_0.log"]}
+    assert_unpacks_to_the_runs(packs, tmp_path / "home", root)
+    assert (tmp_path / "home/packs/task_1+2_pack_0.log").read_text() == "the pack of tasks 1 and 2 (log)\n"

@@ -2,9 +2,11 @@
 GPU takes the longest unfinished task left (task_weight: its runs times the configs each evaluates, plus its
 training), so that the GPUs finish together, and trains it in a child process
 (`kage.bench run ... --task I`, its log in DIR/tasks/task_<I>.log) that sees that GPU alone, until no task
-is left: the same tasks as a Slurm array, resumable the same way, one report. As each task ends it prints the
-tasks left and an ETA: the running tasks' ends at the rates their runs have trained at (their metrics.jsonl), the
-waiting tasks' by weight at the seconds per unit of weight the finished ones took.
+is left: the same tasks as a Slurm array, resumable the same way, one report. Tasks joined by `+` in --tasks
+(`12+13`) train as one: one process, one pack of all their runs (a GPU that one task's pack leaves idle), each
+task still the table's own. As each task ends it prints the tasks left and an ETA: the running tasks' ends at
+the rates their runs have trained at (their metrics.jsonl), the waiting tasks' by weight at the seconds per unit
+of weight the finished ones took.
 
 KAGE_BENCH_FAKE_GPUS=N stands for N GPUs that do not exist, for testing the scheduler on a machine without
 one (with --device cpu): `all` means 0..N-1 and each worker's CUDA_VISIBLE_DEVICES names its fake device."""
@@ -62,10 +64,26 @@ def task_weight(task: List[tasks.Job]) -> int:
     return sum(1 + len(unit.evals) + TRAINING_AS_CONFIGS for unit, _, _ in task)
 
 
-def longest_first(table: List[List[tasks.Job]], indices: List[int]) -> List[int]:
-    """The task indices, the heaviest first (task_weight), ties in table order: the longest-processing-time-first
-    schedule, whose GPUs end close together."""
-    return sorted(indices, key=lambda i: -task_weight(table[i]))
+Group = List[int]  # task indices trained as one (--tasks 12+13), most often one
+
+
+def group_jobs(table: List[List[tasks.Job]], group: Group) -> List[tasks.Job]:
+    return [job for index in group for job in table[index]]
+
+
+def group_name(group: Group) -> str:
+    """[12, 13] -> '12+13', as --task and --tasks take it and as the group's logs and pack files are named."""
+    return "+".join(map(str, group))
+
+
+def every_task(table: List[List[tasks.Job]]) -> List[Group]:
+    return [[index] for index in range(len(table))]
+
+
+def longest_first(table: List[List[tasks.Job]], groups: List[Group]) -> List[Group]:
+    """The groups of tasks, the heaviest first (task_weight), ties in table order: the
+    longest-processing-time-first schedule, whose GPUs end close together."""
+    return sorted(groups, key=lambda group: -task_weight(group_jobs(table, group)))
 
 
 def hand_out(durations: List[float], free_at: List[float]) -> Tuple[List[List[int]], List[float]]:
@@ -108,42 +126,53 @@ def eta_seconds(unit_seconds: float, waiting: List[int], running: List[tuple], w
     return max(hand_out([weight * unit_seconds for weight in waiting], free)[1])
 
 
-def parse_tasks(text: Optional[str], count: int, out: str) -> Optional[List[int]]:
-    """--tasks '0,3,4' -> [0, 3, 4], each an index of the task table of `count` tasks (None: every task)."""
+def parse_tasks(text: Optional[str], count: int, out: str, flag: str = "--tasks") -> Optional[List[Group]]:
+    """--tasks '0,3+4' -> [[0], [3, 4]]: indices of the task table of `count` tasks, those joined by '+' trained
+    as one (None: every task, each alone)."""
     if text is None:
         return None
-    return index_list("--tasks", text, count, f"use task indices like 0,3,4 (see {out}/tasks.json)",
+    return group_list(flag, text, count, f"use task indices like 0,3,4, or 3+4 to train tasks 3 and 4 as one "
+                                         f"(see {out}/tasks.json)",
                       f"the task table of {out} has {count} tasks,", " (see tasks.json)")
+
+
+def group_list(flag: str, text: str, count: int, usage: str, extent: str, see: str = "") -> List[Group]:
+    """`flag`'s '0,2+3' -> [[0], [2, 3]]: groups of distinct indices below `count` (those joined by '+' one
+    group), or an error naming the flag and the fix."""
+    try:
+        groups = [[int(part) for part in item.split("+")] for item in text.split(",")]
+    except ValueError:
+        raise SystemExit(f"kage.bench run: {flag} {text}: {usage}") from None
+    indices = [index for group in groups for index in group]
+    if any(not 0 <= i < count for i in indices) or len(set(indices)) != len(indices):
+        raise SystemExit(f"kage.bench run: {flag} {text}: {extent} 0 to {count - 1}, each named once{see}")
+    return groups
 
 
 def index_list(flag: str, text: str, count: int, usage: str, extent: str, see: str = "") -> List[int]:
     """`flag`'s '0,2' -> [0, 2]: distinct indices below `count`, or an error naming the flag and the fix."""
-    try:
-        indices = [int(part) for part in text.split(",")]
-    except ValueError:
-        raise SystemExit(f"kage.bench run: {flag} {text}: {usage}") from None
-    if any(not 0 <= i < count for i in indices) or len(set(indices)) != len(indices):
-        raise SystemExit(f"kage.bench run: {flag} {text}: {extent} 0 to {count - 1}, each named once{see}")
-    return indices
+    if "+" in text:
+        raise SystemExit(f"kage.bench run: {flag} {text}: {usage}")
+    return [index for group in group_list(flag, text, count, usage, extent, see) for index in group]
 
 
-def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: Optional[List[int]] = None) -> int:
-    """Trains the unfinished tasks of `table` (or of `only`, task indices), one worker per device; prints each
-    task's start and end."""
-    chosen = range(len(table)) if only is None else only
-    unfinished = [i for i in chosen if not all(map(tasks.is_finished, table[i]))]
+def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: Optional[List[Group]] = None) -> int:
+    """Trains the unfinished tasks of `table` (or of `only`, groups of task indices, each trained as one), one
+    worker per device; prints each group's start and end."""
+    chosen = every_task(table) if only is None else only
+    unfinished = [group for group in chosen if not all(map(tasks.is_finished, group_jobs(table, group)))]
     todo = longest_first(table, unfinished)
     finished = sum(all(map(tasks.is_finished, task)) for task in table)
-    scope = "" if only is None else f" (of tasks {','.join(map(str, only))})"
+    scope = "" if only is None else f" (of tasks {','.join(map(group_name, only))})"
     print(f"kage.bench run: {plural(len(table), 'task')}, {finished} finished earlier; {len(todo)} to train{scope} on "
           f"GPUs {','.join(devices)}", file=sys.stderr, flush=True)
     log_dir = os.path.join(bench.out, "tasks")
     os.makedirs(log_dir, exist_ok=True)
     lock = threading.Lock()
     children = {}
-    failed: List[int] = []
+    failed: List[Group] = []
     stopping = threading.Event()
-    began = {}  # device -> (its task's index, weight, when it began, share of its training done then)
+    began = {}  # device -> (its group's jobs, weight, when it began, share of its training done then)
     finished_time, finished_weight = [0.0], [0]  # of tasks trained to the end: a stopped task says nothing
 
     def worker(device: str) -> None:
@@ -151,12 +180,13 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: O
             with lock:
                 if stopping.is_set() or not todo:
                     return
-                index = todo.pop(0)
-                print(f"[gpu {device}] task {index}: {tasks.describe(table[index])}", file=sys.stderr, flush=True)
-                log = open(os.path.join(log_dir, f"task_{index}.log"), "ab")
-                began[device] = (index, task_weight(table[index]), time.monotonic(),
-                                 tasks.task_progress(table[index], bench.steps_per_run))
-                children[device] = subprocess.Popen([*bench.run_command(), "--task", str(index)], stdout=log,
+                group = todo.pop(0)
+                name, jobs = group_name(group), group_jobs(table, group)
+                print(f"[gpu {device}] task {name}: {tasks.describe(jobs)}", file=sys.stderr, flush=True)
+                log = open(os.path.join(log_dir, f"task_{name}.log"), "ab")
+                began[device] = (jobs, task_weight(jobs), time.monotonic(),
+                                 tasks.task_progress(jobs, bench.steps_per_run))
+                children[device] = subprocess.Popen([*bench.run_command(), "--task", name], stdout=log,
                                                     stderr=log, env=child_environment(CUDA_VISIBLE_DEVICES=device))
             code = children[device].wait()
             log.close()
@@ -166,19 +196,19 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: O
                     finished_time[0] += now - began[device][2]
                     finished_weight[0] += began[device][1]
                 if code != 0 and not stopping.is_set():
-                    failed.append(index)
-                running = [(weight, now - start, done_before, tasks.task_progress(table[task], bench.steps_per_run))
-                           for d, (task, weight, start, done_before) in began.items()
+                    failed.append(group)
+                running = [(weight, now - start, done_before, tasks.task_progress(running_jobs, bench.steps_per_run))
+                           for d, (running_jobs, weight, start, done_before) in began.items()
                            if children[d].poll() is None]
                 left = len(todo) + len(running)
                 eta = ""
                 if finished_weight[0] and not stopping.is_set():
                     unit_seconds = finished_time[0] / finished_weight[0]
-                    waiting = [task_weight(table[i]) for i in todo]
+                    waiting = [task_weight(group_jobs(table, group)) for group in todo]
                     eta = f" · ETA {eta_seconds(unit_seconds, waiting, running, len(devices)) / 60:,.0f} min"
                 status = ("done" if code == 0 else "stopped" if stopping.is_set()
                           else f"FAILED (exit {code}); see {log.name}")
-                print(f"[gpu {device}] task {index}: {status} · tasks left {left}{eta}", file=sys.stderr, flush=True)
+                print(f"[gpu {device}] task {name}: {status} · tasks left {left}{eta}", file=sys.stderr, flush=True)
 
     threads = [threading.Thread(target=worker, args=(d,), daemon=True) for d in devices]
     for thread in threads:
@@ -196,9 +226,10 @@ def run_on_gpus(bench, table: List[List[tasks.Job]], devices: List[str], only: O
         print("kage.bench run: stopped; run again to resume", file=sys.stderr, flush=True)
         return 128 + signal.SIGTERM
     if failed:
-        print(f"kage.bench run: task(s) {', '.join(map(str, sorted(failed)))} failed (kage.bench status "
+        print(f"kage.bench run: task(s) {', '.join(map(group_name, sorted(failed)))} failed (kage.bench status "
               f"{bench.out}); rerun to resume them", file=sys.stderr)
         return 1
-    print(f"kage.bench run: {plural(sum(len(table[i]) for i in chosen), 'run')} in {bench.out}; tables and plots: "
-          f"python3 -m kage.bench report {bench.out}", file=sys.stderr)
+    runs = sum(len(group_jobs(table, group)) for group in chosen)
+    print(f"kage.bench run: {plural(runs, 'run')} in {bench.out}; tables and plots: python3 -m kage.bench report "
+          f"{bench.out}", file=sys.stderr)
     return 0

@@ -1,11 +1,13 @@
 """python3 -m kage.bench run SUITE --seeds 1-10 --out DIR [--pairs NAME ...] [--pack K] [--share-training]
-[--task I | --gpus all|0,2 [--tasks 0,3]] [--dry-run] [trainer flags]
+[--task I[+J] | --gpus all|0,2 [--tasks 0,3+4]] [--dry-run] [trainer flags]
 
 Trains every (pair, seed) of a suite manifest with `python3 -m kage.ppo.train`, each run in its own run
 directory, one process after the other; --pack K trains K runs at once in one process (one GPU), which
 the learner's batched forward and backward make several times faster in aggregate. The runs form a fixed
 task table (kage.bench.tasks): --task I trains task I alone (a Slurm array task, kage.bench slurm), and
---gpus keeps one worker per GPU busy with the tasks (kage.bench.gpus). An --agent that cannot be
+--gpus keeps one worker per GPU busy with the tasks (kage.bench.gpus); --task I+J (or --tasks I+J) trains
+tasks I and J as one, in one process and one pack of their runs, for a GPU that one task's pack leaves
+idle, each task still its own in the table. An --agent that cannot be
 packed trains its runs one at a time. --share-training trains pairs that share a train config once per
 seed, in one run that evaluates all their eval configs (the 34 pairs of KAGE-Bench have 7 train configs).
 --dry-run prints the task table, and with --gpus each GPU's tasks, and trains and writes nothing.
@@ -16,10 +18,11 @@ seed, in one run that evaluates all their eval configs (the 34 pairs of KAGE-Ben
     DIR/runs/<pair>/seed_<s>/       a training run (kage.ppo.train's run directory), its train.log and
                                     bench_state.json (running, failed or stopped: kage.bench.run_state)
     DIR/packs/pack_<i>.json, .log   under --pack: the runs one process trained together, and its log
-                                    (task_<I>_pack_<i> under --task I)
-    DIR/tasks/task_<I>.log          under --gpus: the log of task I's process
+                                    (task_<I>_pack_<i> under --task I, task_<I>+<J>_pack_<i> under --task I+J)
+    DIR/tasks/task_<I>.log          under --gpus: the log of task I's process (task_<I>+<J>.log: joined)
     DIR/bench.lock                  while a runner of all tasks (or --gpus) writes DIR; DIR/tasks/task_<I>.lock
-                                    while `--task I` does (kage.util.lock: host, process, start)
+                                    while `--task I` does, each of I and J's under `--task I+J` (kage.util.lock:
+                                    host, process, start)
 
 A plain pair trains on its train config and evaluates on its eval config (label "eval"). A sweep (one
 train config, several evals) runs once per seed and evaluates every eval config of the sweep (labels:
@@ -438,37 +441,45 @@ def record(bench: Bench) -> Bench:
 BENCH_LOCK_ENV = "KAGE_BENCH_LOCK"  # a runner's bench.lock token, which lets its own --task children run
 
 
-def lock_bench(out: str, task: Optional[int]) -> DirectoryLock:
-    """The runner's lock on DIR: bench.lock for a runner of all tasks (refused while a --task process of DIR
-    runs), tasks/task_<I>.lock for --task I (refused while another runner holds bench.lock)."""
+def lock_bench(out: str, group: Optional[gpus.Group]) -> List[DirectoryLock]:
+    """The runner's locks on DIR: bench.lock for a runner of all tasks (refused while a --task process of DIR
+    runs), tasks/task_<I>.lock for each task I of --task I (or I+J) (refused while another runner holds
+    bench.lock)."""
     way_out = f"Wait for it to end or stop it (python3 -m kage.bench status {out}), or use another --out"
     os.makedirs(os.path.join(out, "tasks"), exist_ok=True)
+    held: List[DirectoryLock] = []
     try:
-        if task is not None:
+        if group is not None:
             whole = DirectoryLock(out, "bench", "kage.bench run")
             holder = whole.read()
             if holder is not None and holder.get("token") != os.environ.get(BENCH_LOCK_ENV) and whole.alive(holder):
                 raise LockHeld(whole.describe(holder, way_out))
-            held = DirectoryLock(os.path.join(out, "tasks"), f"task_{task}", f"kage.bench run --task {task}")
-            held.acquire(way_out)
+            for task in group:
+                one = DirectoryLock(os.path.join(out, "tasks"), f"task_{task}",
+                                    f"kage.bench run --task {gpus.group_name(group)}")
+                one.acquire(way_out)
+                held.append(one)
             return held
-        held = DirectoryLock(out, "bench", "kage.bench run")
-        held.acquire(way_out)
+        whole = DirectoryLock(out, "bench", "kage.bench run")
+        whole.acquire(way_out)
+        held.append(whole)
         for name in sorted(os.listdir(os.path.join(out, "tasks"))):
             if name.startswith("task_") and name.endswith(".lock"):
                 one = DirectoryLock(os.path.join(out, "tasks"), name[:-len(".lock")], "")
                 holder = one.read()
                 if holder is not None and one.alive(holder):
-                    held.release()
                     raise LockHeld(one.describe(holder, way_out))
-        os.environ[BENCH_LOCK_ENV] = held.token
+        os.environ[BENCH_LOCK_ENV] = whole.token
         return held
     except LockHeld as e:
+        for lock in reversed(held):
+            lock.release()
         raise SystemExit(f"kage.bench run: {e}") from None
 
 
-def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Optional[int]) -> int:
-    """Trains `jobs` (unit, seed, run_dir) one pack of up to K after the other, skipping finished runs."""
+def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task, size: int) -> int:
+    """Trains `jobs` (unit, seed, run_dir) one pack of up to `size` after the other, skipping finished runs;
+    `task` (the task's index, or the joined tasks' name, or None) is recorded in each run's state."""
     display = Display(len(jobs), bench.steps_per_run)
     pending = []
     for job in jobs:
@@ -478,7 +489,7 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Opti
             os.makedirs(job[2], exist_ok=True)
             pending.append(job)
     failures = []
-    for index, pack in enumerate(packs_of(pending, bench.pack, bench.mix_eval_counts)):
+    for index, pack in enumerate(packs_of(pending, size, bench.mix_eval_counts)):
         labels = [f"{u.name} seed {s}" for u, s, _ in pack]
         run_dirs = [d for _, _, d in pack]
         if len(pack) == 1:
@@ -532,11 +543,12 @@ def main(argv: List[str]) -> int:
                                      epilog="Any other flag is a trainer flag (python3 -m kage.ppo.train --help).",
                                      allow_abbrev=False)  # --seed is a trainer flag, not --seeds
     add_bench_arguments(parser)
-    parser.add_argument("--task", type=int, help="train only task I of DIR/tasks.json (a Slurm array task)")
+    parser.add_argument("--task", help="train only task I of DIR/tasks.json (a Slurm array task); I+J trains tasks "
+                                       "I and J as one pack of their runs")
     parser.add_argument("--gpus", help="'all' or a list like 0,2: one worker process per GPU, each training "
                                        "tasks until none is left")
     parser.add_argument("--tasks", help="with --gpus: only these tasks of DIR/tasks.json, a list like 0,3,4 (what "
-                                        "fits a lease)")
+                                        "fits a lease); 3+4 trains tasks 3 and 4 as one, in one process and pack")
     parser.add_argument("--dry-run", action="store_true",
                         help="print the task table (and, with --gpus, each GPU's tasks) without training or writing")
     args, trainer_args = parser.parse_known_args(argv)
@@ -567,27 +579,38 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
             raise SystemExit("kage.bench run: --device cuda (the trainer's default), but torch sees no GPU here: "
                              "add --device cpu, or run on a GPU machine (kage.bench slurm writes a cluster job)")
     devices = gpus.parse_gpus(args.gpus, bench.device) if args.gpus else None
-    held = lock_bench(bench.out, args.task)
+    group = None if args.task is None else task_group(args.task, len(bench.table()), bench.out)
+    held = lock_bench(bench.out, group)
     try:
-        return run_locked(record(bench), args, devices)
+        return run_locked(record(bench), args, devices, group)
     finally:
-        held.release()
+        for lock in reversed(held):
+            lock.release()
 
 
-def run_locked(bench: Bench, args: argparse.Namespace, devices: Optional[List[str]]) -> int:
-    """main() under the runner's lock."""
+def task_group(text: str, count: int, out: str) -> gpus.Group:
+    """--task 'I' or 'I+J' -> [I] or [I, J], indices of the task table of `count` tasks."""
+    groups = gpus.parse_tasks(text, count, out, "--task")
+    if len(groups) != 1:
+        raise SystemExit(f"kage.bench run: --task {text}: one task (or tasks joined by '+', like 3+4); several "
+                         "tasks one after the other: --gpus all --tasks 3,4")
+    return groups[0]
+
+
+def run_locked(bench: Bench, args: argparse.Namespace, devices: Optional[List[str]],
+               group: Optional[gpus.Group]) -> int:
+    """main() under the runner's lock; `group`, --task's tasks."""
     table = bench.table()
     signal.signal(signal.SIGTERM, raise_stop)
     if devices:
         return gpus.run_on_gpus(bench, table, devices, gpus.parse_tasks(args.tasks, len(table), bench.out))
-    if args.task is None:
-        status = train_jobs(bench, [job for task in table for job in task], "pack_", None)
-    elif not 0 <= args.task < len(table):
-        raise SystemExit(f"kage.bench run: --task {args.task}: the task table of {bench.out} has {len(table)} "
-                         f"tasks, 0 to {len(table) - 1} (see tasks.json)")
+    if group is None:
+        status = train_jobs(bench, [job for task in table for job in task], "pack_", None, bench.pack)
     else:
-        status = train_jobs(bench, table[args.task], f"task_{args.task}_pack_", args.task)
-    if status == 0 and args.task is None:
+        name = gpus.group_name(group)
+        status = train_jobs(bench, gpus.group_jobs(table, group), f"task_{name}_pack_",
+                            group[0] if len(group) == 1 else name, bench.pack * len(group))
+    if status == 0 and group is None:
         print(f"kage.bench run: {plural(sum(map(len, table)), 'run')} in {bench.out}; tables and plots: "
               f"python3 -m kage.bench report {bench.out}", file=sys.stderr)
     return status
