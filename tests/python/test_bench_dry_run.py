@@ -58,6 +58,20 @@ def test_tasks_joined_by_plus_weigh_as_one(capsys, tmp_path, monkeypatch):
     assert gpu_lines[1].startswith("  GPU 1: task 0, weight 260 (51 % ")
 
 
+def test_joined_tasks_that_cannot_share_a_pack_are_named(capsys, tmp_path, monkeypatch):
+    """In kage_bench_loo at --pack 5, task 15 (distractors/4) trains on a mixture of 4 configs and task 16
+    (distractors/5) on a mixture of 2 (the suite's description): joined, they train as two packs, and the dry run
+    says so; tasks 12 and 13 (distractors/1 and /2, mixtures of 4) share one."""
+    monkeypatch.chdir(tmp_path)
+    status = run.main(["kage_bench_loo", "--seeds", "1-5", "--share-training", "--out", "never-made", "--dry-run",
+                       "--pack", "5", "--gpus", "0", "--tasks", "12+13,15+16"])
+    out = capsys.readouterr().out
+    assert status == 0
+    assert "task 12: 5 runs x 2 configs, weight 210: distractors/1" in out
+    assert "tasks 15+16 train as 2 packs, one after the other, not as one" in out
+    assert "tasks 12+13 train as" not in out
+
+
 def test_the_gpus_are_named_as_given(capsys, tmp_path, monkeypatch):
     """--gpus 3,1 trains on GPUs 3 and 1 (the runner's [gpu 3] and [gpu 1]): the dry run names them so, in that
     order, the first taking the heaviest task."""

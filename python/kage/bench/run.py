@@ -222,6 +222,21 @@ def packs_of(jobs: List[tuple], size: int, mix_eval_counts: bool = False) -> Lis
     return [group[i:i + size] for group in groups.values() for i in range(0, len(group), size)]
 
 
+def joined_apart(bench: "Bench", groups: Optional[List[gpus.Group]]) -> List[str]:
+    """A line for each group of joined tasks (--tasks 3+4) whose unfinished runs cannot share one pack (packs_of),
+    which then trains as several packs one after the other."""
+    table, lines = bench.table(), []
+    for group in groups or []:
+        pending = [job for job in gpus.group_jobs(table, group) if not tasks.is_finished(job)]
+        count = len(packs_of(pending, bench.pack * len(group), bench.mix_eval_counts))
+        if len(group) > 1 and count > 1:
+            lines.append(f"kage.bench run: tasks {gpus.group_name(group)} train as {count} packs, one after the "
+                         "other, not as one: a pack's runs evaluate as many configs, train on the same kind of "
+                         "thing (one config, a mixture of as many configs, or a schedule) and resume from the same "
+                         "checkpoint iteration; join tasks whose runs do")
+    return lines
+
+
 def write_pack_file(path: str, pack: List[tuple], trainer_args: List[str]) -> str:
     """The pack's runs as kage.ppo.train arguments (python3 -m kage.ppo.train --pack): each run's Args, its
     training fields (training_fields) set over those of its flags with a single train config."""
@@ -572,6 +587,8 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
             raise SystemExit("kage.bench run: --dry-run shows every task: drop --task")
         only = dry_run.tasks_of(args.tasks, bench.table())
         print(dry_run.describe(bench, dry_run.devices_of(args.gpus) if args.gpus else None, only))
+        for line in joined_apart(bench, only):
+            print(line)
         return 0
     if bench.device == "cuda":
         import torch  # here: kage.bench slurm plans on machines without torch's GPU build
@@ -580,9 +597,12 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
                              "add --device cpu, or run on a GPU machine (kage.bench slurm writes a cluster job)")
     devices = gpus.parse_gpus(args.gpus, bench.device) if args.gpus else None
     group = None if args.task is None else task_group(args.task, len(bench.table()), bench.out)
+    only = gpus.parse_tasks(args.tasks, len(bench.table()), bench.out) if devices else None
+    for line in joined_apart(bench, [group] if group else only):
+        print(line, file=sys.stderr, flush=True)
     held = lock_bench(bench.out, group)
     try:
-        return run_locked(record(bench), args, devices, group)
+        return run_locked(record(bench), devices, group, only)
     finally:
         for lock in reversed(held):
             lock.release()
@@ -597,13 +617,13 @@ def task_group(text: str, count: int, out: str) -> gpus.Group:
     return groups[0]
 
 
-def run_locked(bench: Bench, args: argparse.Namespace, devices: Optional[List[str]],
-               group: Optional[gpus.Group]) -> int:
-    """main() under the runner's lock; `group`, --task's tasks."""
+def run_locked(bench: Bench, devices: Optional[List[str]], group: Optional[gpus.Group],
+               only: Optional[List[gpus.Group]]) -> int:
+    """main() under the runner's lock; `group`, --task's tasks; `only`, --tasks'."""
     table = bench.table()
     signal.signal(signal.SIGTERM, raise_stop)
     if devices:
-        return gpus.run_on_gpus(bench, table, devices, gpus.parse_tasks(args.tasks, len(table), bench.out))
+        return gpus.run_on_gpus(bench, table, devices, only)
     if group is None:
         status = train_jobs(bench, [job for task in table for job in task], "pack_", None, bench.pack)
     else:
