@@ -7,9 +7,9 @@ the learner's batched forward and backward make several times faster in aggregat
 task table (kage.bench.tasks): --task I trains task I alone (a Slurm array task, kage.bench slurm), and
 --gpus keeps one worker per GPU busy with the tasks (kage.bench.gpus); --task I+J (or --tasks I+J) trains
 tasks I and J as one, in one process and one pack of their runs, for a GPU that one task's pack leaves
-idle, each task still its own in the table. An --agent that cannot be
-packed trains its runs one at a time. --share-training trains pairs that share a train config once per
-seed, in one run that evaluates all their eval configs (the 34 pairs of KAGE-Bench have 7 train configs).
+idle, each task still its own in the table. An --agent that cannot be packed trains its runs one at a time.
+--share-training trains pairs that share a train config once per seed, in one run that evaluates all their
+eval configs (the 34 pairs of KAGE-Bench have 7 train configs).
 --dry-run prints the task table, and with --gpus each GPU's tasks, and trains and writes nothing.
 
     DIR/suite.json                  the suite's report (kagec suite): pairs, axes, paths, spec hashes, certificates
