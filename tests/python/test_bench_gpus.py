@@ -21,9 +21,14 @@ def bench(*args, fake_gpus="2"):
                           timeout=900, env=env)
 
 
+def run_args(out):
+    """`kage.bench run` of PAIRS, seed 1, a tiny training each, into `out`: one task a pair."""
+    return ["run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out), *TINY_TRAINING]
+
+
 def test_two_fake_gpus_train_three_tasks(tmp_path):
     out = tmp_path / "bench"
-    args = ["run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out), *TINY_TRAINING]
+    args = run_args(out)
     first = bench(*args, "--gpus", "all")
     assert first.returncode == 0, first.stderr
     assert "3 tasks, 0 finished earlier; 3 to train on GPUs 0,1" in first.stderr
@@ -50,7 +55,7 @@ def test_two_fake_gpus_train_three_tasks(tmp_path):
 
 def test_tasks_picks_what_the_gpus_train(tmp_path):
     out = tmp_path / "bench"
-    args = ["run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out), *TINY_TRAINING]
+    args = run_args(out)
     first = bench(*args, "--gpus", "all", "--tasks", "2,0")
     assert first.returncode == 0, first.stderr
     assert "3 tasks, 0 finished earlier; 2 to train (of tasks 2,0) on GPUs 0,1" in first.stderr
@@ -66,7 +71,7 @@ def test_tasks_joined_by_plus_train_as_one_pack(tmp_path):
     """--tasks 0+2 trains tasks 0 and 2 in one process, one pack of both runs (packs/task_0+2_pack_0.json), on one
     GPU; the runs land where each task's own would, and a rerun finds both finished."""
     out = tmp_path / "bench"
-    args = ["run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out), *TINY_TRAINING]
+    args = run_args(out)
     first = bench(*args, "--gpus", "all", "--tasks", "0+2")
     assert first.returncode == 0, first.stderr
     assert "3 tasks, 0 finished earlier; 1 to train (of tasks 0+2) on GPUs 0,1" in first.stderr
@@ -97,8 +102,7 @@ def test_tasks_joined_by_plus_train_as_one_pack(tmp_path):
 ])
 def test_tasks_is_checked(tmp_path, extra, message):
     out = tmp_path / "bench"
-    refused = bench("run", "suites/kage_bench.yaml", "--pairs", *PAIRS, "--seeds", "1", "--out", str(out),
-                    *TINY_TRAINING, *extra)
+    refused = bench(*run_args(out), *extra)
     assert refused.returncode != 0 and message.format(out=out) in refused.stderr, refused.stderr
     assert not (out / "runs").exists()
 

@@ -39,7 +39,7 @@ import signal
 import subprocess
 import sys
 import time
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Union
 
 import kage
 from kage import front_end, resources
@@ -492,7 +492,8 @@ def lock_bench(out: str, group: Optional[gpus.Group]) -> List[DirectoryLock]:
         raise SystemExit(f"kage.bench run: {e}") from None
 
 
-def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task, size: int) -> int:
+def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Union[int, str, None],
+               size: int) -> int:
     """Trains `jobs` (unit, seed, run_dir) one pack of up to `size` after the other, skipping finished runs;
     `task` (the task's index, or the joined tasks' name, or None) is recorded in each run's state."""
     display = Display(len(jobs), bench.steps_per_run)
@@ -596,8 +597,9 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
             raise SystemExit("kage.bench run: --device cuda (the trainer's default), but torch sees no GPU here: "
                              "add --device cpu, or run on a GPU machine (kage.bench slurm writes a cluster job)")
     devices = gpus.parse_gpus(args.gpus, bench.device) if args.gpus else None
-    group = None if args.task is None else task_group(args.task, len(bench.table()), bench.out)
-    only = gpus.parse_tasks(args.tasks, len(bench.table()), bench.out) if devices else None
+    count = len(bench.table())
+    group = None if args.task is None else task_group(args.task, count, bench.out)
+    only = gpus.parse_tasks(args.tasks, count, bench.out) if devices else None
     for line in joined_apart(bench, [group] if group else only):
         print(line, file=sys.stderr, flush=True)
     held = lock_bench(bench.out, group)
