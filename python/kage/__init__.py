@@ -1,11 +1,12 @@
 """kage: KAGE-Env batches for Python, on the CPU or the GPU, without copies between the runtime and the
 learner, and the front end's checks of configs and suites.
 
-The package has three layers, each importing only those below it:
+The package has four layers, each importing only those below it:
+- ``kage.util``: files, locks, signals, tables (the bottom layer);
 - ``kage`` (this package): the environment API (``make_vec``, ``VecEnv``, ``compile_kernels``, spaces, errors,
   ``kage.front_end``);
 - ``kage.ppo``: the PPO-CNN baseline (``python3 -m kage.ppo.train``, ``python3 -m kage.ppo.evaluate``);
-- ``kage.bench``: the benchmark runner (``python3 -m kage.bench run|report|score|status|slurm|speed``).
+- ``kage.bench``: the benchmark runner (``python3 -m kage.bench run|report|score|status|slurm|speed|compare``).
 
 Importing ``kage`` loads neither torch nor the compiled extension: names below load what they need on
 first use. Where Gymnasium is importable, it registers ``kage/KAGE-v0`` with it (``kage.registration``).

@@ -1,7 +1,7 @@
 // The dependency rules of docs/architecture.md, checked on the #include lines of the source tree:
 // no arrow points up (runtime/ <- compiler/ <- api/, verify/ <- driver/), the front end's early stages
-// include nothing from runtime/, only the driver reaches the verification code, and no source includes
-// lab/ (the lab notebook).
+// include nothing from runtime/, fileio/ includes only itself, only the driver reaches the verification code,
+// and no source includes lab/ (the lab notebook).
 #include <catch2/catch.hpp>
 #include <initializer_list>
 #include <regex>
@@ -85,10 +85,23 @@ TEST_CASE("the compiler includes nothing from the API, verify/ or the driver", "
   CHECK(report.empty());
 }
 
+TEST_CASE("fileio/ includes only itself, and the API and verify/ nothing from the driver", "[layout]") {
+  size_t seen = 0;
+  // fileio/ sits beside the runtime, under everything that reads config files.
+  std::string report = includes_of(
+      {"fileio"}, {"runtime/", "compiler/", "api/", "include/", "kage/", "verify/", "driver/"}, seen);
+  const size_t fileio_seen = seen;
+  report += includes_of({"api", "verify"}, {"driver/"}, seen);
+  INFO("includes against the layout's rules:\n" << report);
+  CHECK(fileio_seen >= 2);  // the scan found fileio's own includes
+  CHECK(seen > fileio_seen + 50);
+  CHECK(report.empty());
+}
+
 TEST_CASE("only the driver includes verify/, and nothing includes lab/", "[layout]") {
   size_t seen = 0;
   std::vector<std::string> offenders;
-  for (const char* dir : {"compiler", "api", "runtime", "verify", "driver"}) {
+  for (const char* dir : {"compiler", "api", "runtime", "fileio", "verify", "driver"}) {
     for (const auto& [where, path] : project_includes(dir)) {
       ++seen;
       const bool in_verify = starts_with(where, "verify/");
