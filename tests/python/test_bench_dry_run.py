@@ -72,6 +72,18 @@ def test_joined_tasks_that_cannot_share_a_pack_are_named(capsys, tmp_path, monke
     assert "tasks 12+13 train as" not in out
 
 
+def test_a_task_that_cannot_be_one_pack_is_named(capsys, tmp_path, monkeypatch):
+    """kage_bench_loo with one seed at --pack 5, in manifest order: filters/1-5 (mixtures of 9) are task 0, one pack;
+    task 1 adds effects/1 (a mixture of 3) to filters/6-9, task 2 distractors/1-3 (of 4) to effects/2-3, task 3
+    distractors/5-6 (of 2) to distractors/4: each trains as 2 packs, and the dry run says so without --gpus too."""
+    monkeypatch.chdir(tmp_path)
+    status = run.main(["kage_bench_loo", "--seeds", "1", "--out", "never-made", "--dry-run", "--pack", "5"])
+    out = capsys.readouterr().out
+    assert status == 0
+    named = re.findall(r"kage.bench run: task (\d+) trains as (\d+) packs, one after the other", out)
+    assert named == [("1", "2"), ("2", "2"), ("3", "2")]
+
+
 def test_the_gpus_are_named_as_given(capsys, tmp_path, monkeypatch):
     """--gpus 3,1 trains on GPUs 3 and 1 (the runner's [gpu 3] and [gpu 1]): the dry run names them so, in that
     order, the first taking the heaviest task."""

@@ -87,13 +87,19 @@ def test_tasks_joined_by_plus_train_as_one_pack(tmp_path):
     again = bench(*args, "--gpus", "all", "--tasks", "2+0,1")
     assert again.returncode == 0, again.stderr
     assert "3 tasks, 2 finished earlier; 1 to train (of tasks 2+0,1)" in again.stderr
+    beyond = bench(*args, "--task", "3")  # the table is written now, so the refusal points at it
+    assert beyond.returncode != 0 and f"0 to 2, each named once (see {out / 'tasks.json'})" in beyond.stderr
 
 
 @pytest.mark.parametrize("extra, message", [
     (["--gpus", "all", "--tasks", "3"], "--tasks 3: the task table of {out} has 3 tasks, 0 to 2, each named once"),
     (["--gpus", "all", "--tasks", "0,1+0"], "--tasks 0,1+0: the task table of {out} has 3 tasks, 0 to 2, each named"),
     (["--gpus", "all", "--tasks", "0+"], "--tasks 0+: use task indices like 0,3,4, or 3+4 to train tasks 3 and 4"),
-    (["--task", "3"], "--task 3: the task table of {out} has 3 tasks, 0 to 2, each named once (see tasks.json)"),
+    (["--task", "3"], "--task 3: the task table of {out} has 3 tasks, 0 to 2, each named once (--dry-run lists "
+                      "them)"),
+    (["--task", " 1"], "--task  1: use task indices like 0,3,4"),  # int() would take these three
+    (["--task", "1_0"], "--task 1_0: use task indices like 0,3,4"),
+    (["--task", "\u0663"], "--task \u0663: use task indices like 0,3,4"),
     (["--task", "0,1"], "--task 0,1: one task (or tasks joined by '+', like 3+4); several tasks one after the other: "
                         "--gpus all --tasks 3,4"),
     (["--gpus", "all", "--tasks", "1,1"], "--tasks 1,1: the task table of {out} has 3 tasks"),

@@ -94,6 +94,9 @@ def test_report_reads_a_mixture_units_runs(tmp_path):
     result = report.report(str(tmp_path))
     row = next(p for p in result["levels"]["pairs"] if p["pair"] == "filters/1")
     assert row["train_spec"] == "m" * 64  # the mixture's identity: its configs' Specs and weights
+    assert row["trains_on"] == "mixture of 2"  # as the suite names it
+    assert "Pairs that train on several configs: filters/1 (mixture of 2)." in \
+        (tmp_path / "report" / "pairs.md").read_text()
     assert row["metrics"]["success_once"]["train"]["mean"] == 0.8
     assert row["metrics"]["success_once"]["eval"]["mean"] == 0.2
 

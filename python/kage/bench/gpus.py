@@ -12,6 +12,7 @@ KAGE_BENCH_FAKE_GPUS=N stands for N GPUs that do not exist, for testing the sche
 one (with --device cpu): `all` means 0..N-1 and each worker's CUDA_VISIBLE_DEVICES names its fake device."""
 import heapq
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -131,18 +132,19 @@ def parse_tasks(text: Optional[str], count: int, out: str, flag: str = "--tasks"
     as one (None: every task, each alone)."""
     if text is None:
         return None
-    return group_list(flag, text, count, f"use task indices like 0,3,4, or 3+4 to train tasks 3 and 4 as one "
-                                         f"(see {out}/tasks.json)",
-                      f"the task table of {out} has {count} tasks,", " (see tasks.json)")
+    table = os.path.join(out, "tasks.json")
+    see = f"see {table}" if os.path.isfile(table) else "--dry-run lists them"
+    return group_list(flag, text, count, f"use task indices like 0,3,4, or 3+4 to train tasks 3 and 4 as one ({see})",
+                      f"the task table of {out} has {count} tasks,", f" ({see})")
 
 
 def group_list(flag: str, text: str, count: int, usage: str, extent: str, see: str = "") -> List[Group]:
     """`flag`'s '0,2+3' -> [[0], [2, 3]]: groups of distinct indices below `count` (those joined by '+' one
     group), or an error naming the flag and the fix."""
-    try:
-        groups = [[int(part) for part in item.split("+")] for item in text.split(",")]
-    except ValueError:
-        raise SystemExit(f"kage.bench run: {flag} {text}: {usage}") from None
+    groups = [item.split("+") for item in text.split(",")]
+    if not all(re.fullmatch("[0-9]+", part) for group in groups for part in group):  # int() takes ' 1', '1_0'
+        raise SystemExit(f"kage.bench run: {flag} {text}: {usage}")
+    groups = [[int(part) for part in group] for group in groups]
     indices = [index for group in groups for index in group]
     if any(not 0 <= i < count for i in indices) or len(set(indices)) != len(indices):
         raise SystemExit(f"kage.bench run: {flag} {text}: {extent} 0 to {count - 1}, each named once{see}")

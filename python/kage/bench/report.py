@@ -411,6 +411,7 @@ def aggregate(units: List[Unit], runs: Dict[str, List[Run]], protocol: str = "ma
             results[pair["pair"]] = {
                 "pair": pair["pair"], "axis": pair["declared_axis"], "certified": pair.get("certified"),
                 "train_spec": pair["train"].get("spec_sha256", pair["train"].get("name")),
+                "trains_on": unit.train if "stages" in unit.training else None,
                 "n_seeds": len(kept), "seeds": [r.seed for r, _ in kept], "metrics": over_seeds(per_run)}
         if not unit.is_sweep:
             pairs.extend(results[p["pair"]] for p in unit.pairs)

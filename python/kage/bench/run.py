@@ -222,18 +222,19 @@ def packs_of(jobs: List[tuple], size: int, mix_eval_counts: bool = False) -> Lis
     return [group[i:i + size] for group in groups.values() for i in range(0, len(group), size)]
 
 
-def joined_apart(bench: "Bench", groups: Optional[List[gpus.Group]]) -> List[str]:
-    """A line for each group of joined tasks (--tasks 3+4) whose unfinished runs cannot share one pack (packs_of),
-    which then trains as several packs one after the other."""
+def split_tasks(bench: "Bench", groups: Optional[List[gpus.Group]]) -> List[str]:
+    """A line for each task, or group of joined tasks (--tasks 3+4), of `groups` (None: every task) whose unfinished
+    runs cannot share one pack (packs_of), and so train as several packs one after the other."""
     table, lines = bench.table(), []
-    for group in groups or []:
+    for group in gpus.every_task(table) if groups is None else groups:
         pending = [job for job in gpus.group_jobs(table, group) if not tasks.is_finished(job)]
         count = len(packs_of(pending, bench.pack * len(group), bench.mix_eval_counts))
-        if len(group) > 1 and count > 1:
-            lines.append(f"kage.bench run: tasks {gpus.group_name(group)} train as {count} packs, one after the "
-                         "other, not as one: a pack's runs evaluate as many configs, train on the same kind of "
-                         "thing (one config, a mixture of as many configs, or a schedule) and resume from the same "
-                         "checkpoint iteration; join tasks whose runs do")
+        if count > 1:
+            named = f"task {group[0]} trains" if len(group) == 1 else f"tasks {gpus.group_name(group)} train"
+            lines.append(f"kage.bench run: {named} as {count} packs, one after the other, not as one: a pack's runs "
+                         "evaluate as many configs, train on the same kind of thing (one config, a mixture of as many "
+                         "configs, or a schedule) and resume from the same checkpoint iteration"
+                         f"{'; join tasks whose runs do' if len(group) > 1 else ''}")
     return lines
 
 
@@ -588,7 +589,7 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
             raise SystemExit("kage.bench run: --dry-run shows every task: drop --task")
         only = dry_run.tasks_of(args.tasks, bench.table())
         print(dry_run.describe(bench, dry_run.devices_of(args.gpus) if args.gpus else None, only))
-        for line in joined_apart(bench, only):
+        for line in split_tasks(bench, only):
             print(line)
         return 0
     if bench.device == "cuda":
@@ -600,8 +601,9 @@ def run_command(args: argparse.Namespace, trainer_args: List[str]) -> int:
     count = len(bench.table())
     group = None if args.task is None else task_group(args.task, count, bench.out)
     only = gpus.parse_tasks(args.tasks, count, bench.out) if devices else None
-    for line in joined_apart(bench, [group] if group else only):
-        print(line, file=sys.stderr, flush=True)
+    if group or devices:  # without either, packs_of packs the whole table's runs, not task by task
+        for line in split_tasks(bench, [group] if group else only):
+            print(line, file=sys.stderr, flush=True)
     held = lock_bench(bench.out, group)
     try:
         return run_locked(record(bench), devices, group, only)

@@ -103,6 +103,9 @@ def md_pairs(pairs: List[dict], level: int) -> str:
     uncertified = [p["pair"] for p in pairs if p["certified"] is False]
     if uncertified:
         sections.append(f"Pairs that kagec did not certify (see suite.json): {', '.join(uncertified)}.\n")
+    several = [f"{p['pair']} ({p['trains_on']})" for p in pairs if p.get("trains_on")]
+    if several:
+        sections.append(f"Pairs that train on several configs: {', '.join(several)}.\n")
     return "\n".join(sections)
 
 
