@@ -27,25 +27,45 @@ def _number(value) -> bool:
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
 
 
+class WeightsError(ValueError):
+    """Weights that are not a mixture's; `index` is the weight at fault, or None where the list as a whole is."""
+
+    def __init__(self, message: str, index=None):
+        super().__init__(message)
+        self.index = index
+
+
+def _shown(value, width: int = 40) -> str:
+    text = repr(value)
+    return text if len(text) <= width else text[:width - 3] + "..."
+
+
+def _finite(w) -> bool:
+    try:
+        return math.isfinite(float(w))
+    except OverflowError:  # an int beyond float's range
+        return False
+
+
 def weights_of(weights, num_configs: int) -> List[Fraction]:
     """The weights as exact fractions: None gives every config weight 1; else `num_configs` finite
-    non-negative numbers, not all zero. ValueError naming the first that is not."""
+    non-negative numbers, not all zero. WeightsError naming the first that is not."""
     if weights is None:
         return [Fraction(1)] * num_configs
     if isinstance(weights, (str, bytes)) or not hasattr(weights, "__len__"):
-        raise ValueError(f"weights={weights!r:.80}: a list of {num_configs} non-negative numbers, one per config")
+        raise WeightsError(f"weights={weights!r:.80}: a list of {num_configs} non-negative numbers, one per config")
     values = list(np.asarray(weights, dtype=object).reshape(-1)) if isinstance(weights, np.ndarray) else list(weights)
     if len(values) != num_configs:
-        raise ValueError(f"weights: {len(values)} given for {num_configs} configs: one weight per config")
+        raise WeightsError(f"weights: {len(values)} given for {num_configs} configs: one weight per config")
     exact = []
     for i, w in enumerate(values):
         if not _number(w):
-            raise ValueError(f"weights[{i}]={w!r:.40}: a number (int or float), one per config")
-        if not math.isfinite(float(w)) or w < 0:
-            raise ValueError(f"weights[{i}]={w!r}: a finite number >= 0")
+            raise WeightsError(f"weights[{i}]={_shown(w)}: a number (int or float), one per config", i)
+        if not _finite(w) or w < 0:
+            raise WeightsError(f"weights[{i}]={_shown(w)}: a finite number >= 0", i)
         exact.append(Fraction(int(w)) if isinstance(w, (int, np.integer)) else Fraction(float(w)))
     if sum(exact) == 0:
-        raise ValueError("weights: all zero; give at least one config a positive weight")
+        raise WeightsError("weights: all zero; give at least one config a positive weight")
     return exact
 
 

@@ -1,6 +1,7 @@
 """Plug-ins that break the contract (kage.ppo.plugins), each refused before the trainer writes anything
 (tests/python/test_checks_before_writing.py), or, drawing from a global random generator, warned of
-(tests/python/test_plugins.py)."""
+(tests/python/test_plugins.py); one fails only on real frames, in training (a run that stops before its first
+checkpoint, started over when rerun with another augmentation)."""
 import numpy as np
 import torch
 import torch.nn as nn
@@ -28,6 +29,24 @@ def other_device(obs, uniform):
 
 def raises(obs, uniform):
     raise RuntimeError("this augmentation is broken")
+
+
+def exits(obs, uniform):
+    raise SystemExit(3)
+
+
+def ignores_images(obs, uniform, images=None):
+    return obs  # the frame store itself, not the frames at `images`
+
+
+ignores_images.takes_frame_indices = True
+
+
+def raises_on_real_frames(obs, uniform):
+    """Passes the check on blank frames, then fails in the first update."""
+    if obs.any():
+        raise ValueError("not on real frames")
+    return obs
 
 
 class NoParameters(nn.Module):

@@ -25,7 +25,7 @@ BASE = ["--train-config-path", NOISY_SKELETON, "--seed", "3", "--threads", "1", 
     ["--reward-clip-min", "1", "--reward-clip-max", "0"], ["--reward-clip-min", "nan"], ["--seed", "-1"],
     ["--seed", str(2**64)], ["--save-checkpoint-every", "-1"], ["--threads", "0"], ["--threads", "-2"],
     ["--num-envs", str(2**31)], ["--eval-num-envs", str(2**31)], ["--num-steps", str(2**40)],
-    ["--asset-root", "/nonexistent-asset-root"],
+    ["--asset-root", "/nonexistent-asset-root"], ["--augment", ""], ["--augment", " "],
 ], ids=lambda flags: " ".join(flags))
 def test_nonsense_values_are_refused_before_anything_is_written(tmp_path, flags):
     out = tmp_path / "run"
@@ -33,6 +33,16 @@ def test_nonsense_values_are_refused_before_anything_is_written(tmp_path, flags)
         train.main(BASE + ["--device", "cpu", "--out", str(out), *flags])
     assert caught.value.code != 0
     assert not out.exists()
+
+
+def test_a_flag_error_is_one_line(capsys):
+    """Not after argparse's usage block of every flag."""
+    with pytest.raises(SystemExit) as caught:
+        train.main(BASE + ["--device", "cpu", "--drac-coef", "abc"])
+    err = capsys.readouterr().err
+    assert caught.value.code == 2
+    assert err.strip().splitlines() == ["python3 -m kage.ppo.train: error: argument --drac-coef: invalid float value: "
+                                        "'abc' (python3 -m kage.ppo.train --help lists every flag)"]
 
 
 @pytest.mark.parametrize("first, fix", [
@@ -46,13 +56,16 @@ def test_nonsense_values_are_refused_before_anything_is_written(tmp_path, flags)
     (["--augment", "bad_plugins:fewer_rows"], []),
     (["--augment", "bad_plugins:other_device"], []),
     (["--augment", "bad_plugins:raises"], []),
+    (["--augment", "bad_plugins:exits"], []),
+    (["--augment", "bad_plugins:ignores_images"], []),
     (["--augment", "bad_plugins:float_frames", "--augment-mode", "rollout"], []),
     (["--agent", "os:system"], []),
     (["--agent", "bad_plugins:no_parameters"], []),
     (["--agent", "bad_plugins:integer_logits"], []),
     (["--num-envs", "20000", "--num-minibatches", "1", "--total-timesteps", "2560000"], []),
 ], ids=["agent-module", "agent-factory", "augment", "memory", "augment-float", "augment-none", "augment-shape",
-        "augment-rows", "augment-device", "augment-raises", "augment-float-rollout", "agent-not-a-factory",
+        "augment-rows", "augment-device", "augment-raises", "augment-exits", "augment-ignores-images",
+        "augment-float-rollout", "agent-not-a-factory",
         "agent-no-parameters", "agent-integer-outputs", "rollout-buffer"])
 def test_a_refused_run_writes_nothing_and_its_corrected_rerun_trains(tmp_path, capsys, first, fix):
     out = tmp_path / "run"
@@ -114,3 +127,22 @@ def test_an_augmentation_drawing_from_a_global_generator_trains_with_a_warning(t
     assert "kage.ppo.train: warning: --augment bad_plugins:global_torch_noise draws from torch's global random " \
            "generator" in capsys.readouterr().err
     assert (out / "summary.json").exists()
+
+
+def test_a_run_that_fails_before_its_first_checkpoint_starts_over_with_the_fix(tmp_path, capsys):
+    """An augmentation that passes the check on blank frames and fails in the first update stops its run in one
+    line, before any checkpoint: nothing is lost, so a rerun with another augmentation starts the run over."""
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as failed:
+        train.main(BASE + ["--device", "cpu", "--out", str(out), "--augment", "bad_plugins:raises_on_real_frames"])
+    message = str(failed.value.code)
+    assert message.startswith("kage.ppo.train: --augment bad_plugins:raises_on_real_frames: on uint8 frames ") and \
+        message.endswith("it raised ValueError: not on real frames"), message
+    assert not (out / "checkpoints" / "latest.pt").exists()
+    capsys.readouterr()
+    assert train.main(BASE + ["--device", "cpu", "--out", str(out), "--augment", "kage.ppo.augment:random_shift"]) == 0
+    assert f"kage.ppo.train: {out} stopped before its first checkpoint" in capsys.readouterr().err
+    recorded = json.loads((out / "run.json").read_text())["args"]
+    assert recorded["augment"] == "kage.ppo.augment:random_shift"
+    with pytest.raises(SystemExit, match="was started with other arguments"):  # a checkpoint now: a resume's rules
+        train.main(BASE + ["--device", "cpu", "--out", str(out), "--augment", "kage.ppo.augment:grayscale"])

@@ -183,6 +183,7 @@ def test_a_different_observation_shape_is_refused_in_one_located_line(nothing_op
     ([1, 1], r"^weights: 2 given for 3 configs: one weight per config$"),
     ([1, True, 1], r"^weights\[1\]=True: a number \(int or float\), one per config$"),
     ("111", r"^weights='111': a list of 3 non-negative numbers, one per config$"),
+    ([1, 10 ** 400, 1], r"^weights\[1\]=1000000000000000000000000000000000000\.\.\.: a finite number >= 0$"),
 ])
 def test_bad_weights_are_refused_in_one_line(nothing_opened, weights, text):
     with pytest.raises(ValueError, match=text) as e:

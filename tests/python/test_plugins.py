@@ -28,6 +28,27 @@ def test_references_are_checked_with_their_fix():
         plugins.load_augment("kage.ppo.augment:xyz")
     with pytest.raises(SystemExit, match=r"must take \(obs, uniform\)"):
         plugins.load_augment("math:sqrt")
+    with pytest.raises(SystemExit, match=r"write it as module:attribute \(e.g. kage.ppo.augment:random_shift\)"):
+        plugins.load_augment("random_shift")
+
+
+def test_a_module_that_fails_to_import_is_named_with_its_fix(tmp_path, monkeypatch):
+    """The module is found but its import fails: its own error and where, or the import it lacks; a file path
+    instead of a module's name is named as such."""
+    (tmp_path / "syntax_error_aug.py").write_text("def aug(obs, uniform) return obs\n")
+    (tmp_path / "raising_aug.py").write_text("raise RuntimeError('module-level failure')\n")
+    (tmp_path / "lacking_aug.py").write_text("import no_such_dependency_xyz\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with pytest.raises(SystemExit, match=r"importing 'syntax_error_aug' raised SyntaxError: .*syntax_error_aug.py, "
+                                         r"line 1\); fix the module$"):
+        plugins.load_augment("syntax_error_aug:aug")
+    with pytest.raises(SystemExit, match=r"importing 'raising_aug' raised RuntimeError: module-level failure; fix"):
+        plugins.load_augment("raising_aug:aug")
+    with pytest.raises(SystemExit, match=r"importing 'lacking_aug' failed: No module named 'no_such_dependency_xyz'; "
+                                         r"install what it imports"):
+        plugins.load_augment("lacking_aug:aug")
+    with pytest.raises(SystemExit, match=r"name a module, not a file: raising_aug:aug, with the directory"):
+        plugins.load_augment(f"{tmp_path}/raising_aug.py:aug")
 
 
 @pytest.mark.parametrize("reference, generators", [

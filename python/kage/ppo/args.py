@@ -155,11 +155,17 @@ class DefaultsShown(argparse.HelpFormatter):
         return text + " (default: %(default)s)"
 
 
+class OneLineErrors(argparse.ArgumentParser):
+    """An error in one line with where the flags are listed, not after a usage block of every flag (about 45 lines)."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} ({self.prog} --help lists every flag)\n")
+
+
 def parse_args(argv: Optional[List[str]] = None) -> Args:
     """The flags of Args: --snake-case names, booleans as --flag / --no-flag."""
     # No abbreviations: kage.bench refuses the per-run flags by their full names, which an abbreviation would pass.
-    parser = argparse.ArgumentParser(prog=PROG, description=DESCRIPTION, allow_abbrev=False,
-                                     formatter_class=DefaultsShown)
+    parser = OneLineErrors(prog=PROG, description=DESCRIPTION, allow_abbrev=False, formatter_class=DefaultsShown)
     for f in dataclasses.fields(Args):
         flag = "--" + f.name.replace("_", "-")
         default = f.default_factory() if f.default_factory is not dataclasses.MISSING else f.default
@@ -322,7 +328,10 @@ def validate(args: Args) -> List[str]:
     if args.agent != plugins.BASELINE_AGENT and (args.fused_input or args.channels_last or args.triton_conv):
         problems.append("--fused-input, --channels-last and --triton-conv rewrite the baseline's network: drop them "
                         "with --agent")
-    if args.augment_mode and not args.augment:
+    if args.augment is not None and not args.augment.strip():
+        problems.append(f"--augment {args.augment!r}: name an augmentation as module:function (e.g. "
+                        "kage.ppo.augment:random_shift), or leave the flag out")
+    elif args.augment_mode and not args.augment:
         problems.append(f"--augment-mode {args.augment_mode} needs --augment module:fn (e.g. "
                         "kage.ppo.augment:color_jitter), or drop --augment-mode")
     elif args.augment_mode is not None and args.augment_mode not in AUGMENT_MODES:

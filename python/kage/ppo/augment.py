@@ -14,7 +14,7 @@ targets and where its parameters come from.
     color_jitter    brightness, contrast, saturation 0.4, hue 0.5 (RAD's and DrAC's ColorJitter settings)
     grayscale       luma in all channels with probability 0.3 (RAD)
     random_conv     a random 3x3 convolution, Xavier-normal weights (Lee et al. 2020, network randomization)
-    cutout_color    one box of 10-30 / 84 of the side in a random colour (RAD's cutout-color)
+    cutout_color    one box of 10-29 / 84 of the side in a random colour (RAD's cutout-color)
     gaussian_noise  additive N(0, 25.5) per pixel, 10 % of the range (our setting; no single source)
     overlay         alpha 0.5 blend with a random shipped background image (SVEA, Hansen et al. 2021)
 """
@@ -147,8 +147,8 @@ def random_conv(obs: torch.Tensor, uniform, images: Optional[torch.Tensor] = Non
 
 @takes_frame_indices
 def cutout_color(obs: torch.Tensor, uniform, images: Optional[torch.Tensor] = None) -> torch.Tensor:
-    """One box per frame, each side CUTOUT_SIDES of the frame's (RAD: 10 to 30 of 84 pixels), at a random
-    position inside the frame, filled with a random colour."""
+    """One box per frame, each side in [low, high) of CUTOUT_SIDES of the frame's (RAD's randint: 10 to 29 of 84
+    pixels), at a random position inside the frame, filled with a random colour."""
     k, b, h, w = _frame_shape(obs, images)
     u = uniform((b, 7))
     side = _pair(k, b, h, w, obs.device)

@@ -146,6 +146,7 @@ def resume(runs: List[Run], agent, optimizer, state: LoopState, stack, normalize
     state.optimizer_steps, state.train_seconds = c["optimizer_steps"], c["train_seconds"]
     streams.wait_for(run.stream for run in runs)
     for run in runs:
+        mode = f"; --augment-mode {run.args.augment_mode}, as it started" if run.args.augment else ""
         print(f"kage.ppo.train: resuming {run.dir.path} after iteration {c['iteration']} (its checkpoint, log and "
-              "arguments agree)", file=sys.stderr)
+              f"arguments agree{mode})", file=sys.stderr)
     return True

@@ -37,6 +37,7 @@ from kage.ppo.counter_random import CounterRandom
 from kage.ppo.policy import autocast
 
 BASELINE_AGENT = "kage.ppo.agent:nature_cnn"
+EXAMPLES = {"--agent": BASELINE_AGENT, "--augment": "kage.ppo.augment:random_shift"}  # each flag's own kind
 # Modules of the package that moved: references written before (command lines, run.json) still name them.
 MOVED_MODULES = {"kage.agent": "kage.ppo.agent", "kage.augment": "kage.ppo.augment"}
 
@@ -52,13 +53,25 @@ def current_reference(reference: Optional[str]) -> Optional[str]:
 def load(reference: str, flag: str) -> Callable:
     """The callable named by `module:attribute`, or a SystemExit naming the flag and the fix."""
     module_name, _, attribute = current_reference(reference).partition(":")
-    if not module_name or not attribute:
-        raise SystemExit(f"kage.ppo.train: {flag} {reference!r}: write it as module:attribute (e.g. {BASELINE_AGENT})")
+    example = EXAMPLES.get(flag, BASELINE_AGENT)
+    if not module_name.strip() or not attribute.strip():
+        raise SystemExit(f"kage.ppo.train: {flag} {reference!r}: write it as module:attribute (e.g. {example})")
+    if module_name.endswith(".py") or "/" in module_name:
+        stem = module_name.rsplit("/", 1)[-1].removesuffix(".py")
+        raise SystemExit(f"kage.ppo.train: {flag} {reference}: name a module, not a file: {stem}:{attribute}, with the "
+                         "directory that holds it on PYTHONPATH")
     try:
         module = importlib.import_module(module_name)
     except ImportError as e:
+        if e.name and not (module_name + ".").startswith(e.name + "."):  # found, but a module it imports is not
+            raise SystemExit(f"kage.ppo.train: {flag} {reference}: importing '{module_name}' failed: {e}; install "
+                             "what it imports, or fix the import") from None
         raise SystemExit(f"kage.ppo.train: {flag} {reference}: cannot import '{module_name}' ({e}); put the directory "
                          "that holds it on PYTHONPATH") from None
+    except Exception as e:  # a user's module: whatever its import raises is reported as its failure
+        where = f" ({e.filename}, line {e.lineno})" if isinstance(e, SyntaxError) else ""
+        raise SystemExit(f"kage.ppo.train: {flag} {reference}: importing '{module_name}' raised "
+                         f"{type(e).__name__}: {e}{where}; fix the module") from None
     found = getattr(module, attribute, None)
     if not callable(found):
         names = list(getattr(module, "__all__", None) or  # the module's own list of what it offers, else its functions
@@ -179,17 +192,25 @@ def augment_frames(fn: Callable, reference: str, frames: torch.Tensor, uniform: 
     """fn on `frames` (at `images` where given: see the contract above), its output checked: uint8 frames of the
     input's shape on its device. Outside any autocast (a truncation's bootstrap runs under --bf16's), so that its
     parameters are the same float32 numbers wherever it is called."""
+    at_indices = images is not None and getattr(fn, "takes_frame_indices", False) is True
     with torch.autocast(frames.device.type, enabled=False):
-        if images is not None and getattr(fn, "takes_frame_indices", False) is True:
-            out = fn(frames, uniform, images=images)
-            expected = (*images.shape, *frames.shape[-3:])
-        else:
-            frames = frames if images is None else frames.reshape(-1, *frames.shape[-3:])[images]
-            out = fn(frames, uniform)
-            expected = tuple(frames.shape)
+        try:
+            if at_indices:
+                out = fn(frames, uniform, images=images)
+                expected = (*images.shape, *frames.shape[-3:])
+            else:
+                frames = frames if images is None else frames.reshape(-1, *frames.shape[-3:])[images]
+                out = fn(frames, uniform)
+                expected = tuple(frames.shape)
+        except (Exception, SystemExit) as e:  # a user's function: whatever it raises is reported as its failure
+            raise SystemExit(f"kage.ppo.train: --augment {reference}: on uint8 frames {list(frames.shape)}"
+                             f"{f' at images {list(images.shape)}' if at_indices else ''} it raised "
+                             f"{type(e).__name__}: {e}") from None
     problem = augmented_problem(out, expected, frames.device)
     if problem:
-        raise SystemExit(f"kage.ppo.train: --augment {reference}: {problem}")
+        contract = (" (called with images=, run k's b-th frame is frames.reshape(-1, H, W, C)[images[k, b]]: it "
+                    "returns one frame per index)") if at_indices else ""
+        raise SystemExit(f"kage.ppo.train: --augment {reference}: {problem}{contract}")
     if out is not frames and out.untyped_storage().data_ptr() == frames.untyped_storage().data_ptr():
         out = out.clone()  # a view of its input (a transpose, a slice): its own memory, for the copy into the rollout
     return out
@@ -239,15 +260,10 @@ def check_augment(fn: Callable, reference: str, shape, device) -> Optional[str]:
     random = CounterRandom([0] * shape[0], device)
     counter = torch.zeros((), dtype=torch.int64, device=device)
     blank = torch.zeros(shape, dtype=torch.uint8, device=device)
-    images = torch.arange(shape[0] * shape[1], device=device).view(shape[0], shape[1])
-    for at in (None, images):
-        try:
-            augment_frames(fn, reference, blank, augment_draws(random, 0, counter, 0), at)
-        except SystemExit:
-            raise
-        except Exception as e:  # a user's function: whatever it raises is reported as its failure
-            raise SystemExit(f"kage.ppo.train: --augment {reference}: on blank uint8 frames {list(shape)} it raised "
-                             f"{type(e).__name__}: {e}") from None
+    # One index more per run than frames per run, so that a function that ignores `images` returns the wrong shape.
+    images = torch.arange(shape[0] * (shape[1] + 1), device=device).remainder(shape[0] * shape[1])
+    for at in (None, images.view(shape[0], shape[1] + 1)):
+        augment_frames(fn, reference, blank, augment_draws(random, 0, counter, 0), at)
     after = global_generators(device)
     drawn = [name for name in before if not same_state(before[name], after[name])]
     if not drawn:

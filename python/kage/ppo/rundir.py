@@ -28,6 +28,7 @@ import hashlib
 import json
 import math
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -44,7 +45,9 @@ from kage.ppo.args import DEFAULT_AUGMENT_MODE, configs_of, first_train_config, 
 from kage.util.files import atomic_write, named_errors, read_json_record, remove_strays, safe, write_json
 from kage.util.lock import DirectoryLock, LockHeld
 
-_RESUMABLE_CHANGES = {"out", "threads"}  # arguments that may differ on resume
+# Arguments that may differ on resume; a schedule file named by another path (cur.yaml, then /abs/cur.yaml) is
+# held to the run by its configs and stages, which check_same_run compares themselves.
+_RESUMABLE_CHANGES = {"out", "threads", "train_schedule"}
 # Arguments added since runs were first written, with the value that means what a run without them did.
 _ADDED_ARGUMENTS = {"agent": "kage.ppo.agent:nature_cnn", "augment": None, "video_every": 0, "drac_coef": 0.1,
                     "train_config_paths": [], "train_weights": [], "train_schedule": None}
@@ -329,10 +332,22 @@ def describe_or_check(path: str, args, configs: List[Tuple[str, str]], specs: Di
     for folder in ("", "configs", "certificates", "checkpoints", "videos"):
         remove_strays(os.path.join(path, folder))  # a killed writer's, or one that met a full disk
     run_json = os.path.join(path, "run.json")
-    if os.path.exists(run_json):
-        check_same_run(path, read_run_json(run_json), json_args(args), described, stages)
-        return
     log = os.path.join(path, "metrics.jsonl")
+    if os.path.exists(run_json):
+        difference = run_difference(path, read_run_json(run_json), json_args(args), described, stages)
+        if difference is None:
+            return
+        if os.path.exists(os.path.join(path, "checkpoints", "latest.pt")):
+            raise SystemExit(difference)
+        # Stopped before its first checkpoint (an augmentation that failed on real frames, say): nothing to resume,
+        # so a rerun with corrected arguments starts the run over rather than being refused.
+        print(f"kage.ppo.train: {path} stopped before its first checkpoint, so nothing is lost: starting it over "
+              "with these arguments, not those it was started with", file=sys.stderr, flush=True)
+        for folder in ("configs", "certificates"):
+            shutil.rmtree(os.path.join(path, folder), ignore_errors=True)
+        for stale in (run_json, log):
+            if os.path.exists(stale):
+                os.remove(stale)
     if os.path.exists(os.path.join(path, "checkpoints", "latest.pt")) or (os.path.exists(log) and os.path.getsize(log)):
         raise SystemExit(f"kage.ppo.train: {path} has a checkpoint or log rows but no run.json, so nothing shows which "
                          "arguments and configs they belong to: restore run.json, or train anew with another --out")
@@ -473,23 +488,32 @@ def with_augment_mode(args):
 
 def check_same_run(path: str, previous: dict, args: dict, configs: dict, stages: Optional[List[dict]]) -> None:
     """Refuses to resume `path` with other arguments, with configs whose Spec changed, or with other stages."""
+    difference = run_difference(path, previous, args, configs, stages)
+    if difference:
+        raise SystemExit(difference)
+
+
+def run_difference(path: str, previous: dict, args: dict, configs: dict, stages: Optional[List[dict]]) -> Optional[str]:
+    """Why `args`, `configs` and `stages` are not the run recorded in `previous` (the message and its fix), or None."""
     for label, now in configs.items():
         before = previous["configs"].get(label)
         if before is None or before["path"] != now["path"]:
-            raise SystemExit(f"kage.ppo.train: {path} was started with other configs; use another --out")
+            then = "no such config" if before is None else before["path"]
+            return (f"kage.ppo.train: {path} was started with other configs ({label}: {then} then, {now['path']} "
+                    "now): rerun with the original configs to resume, or use another --out")
         if before["spec_sha256"] != now["spec_sha256"]:
-            raise SystemExit(
-                f"kage.ppo.train: config '{now['path']}' ({label}) changed since {path} started (spec "
-                f"{before['spec_sha256'][:12]} then, {now['spec_sha256'][:12]} now): restore it, or start a new run "
-                "with another --out")
+            return (f"kage.ppo.train: config '{now['path']}' ({label}) changed since {path} started (spec "
+                    f"{before['spec_sha256'][:12]} then, {now['spec_sha256'][:12]} now): restore it, or start a new "
+                    "run with another --out")
     if previous.get("stages") != stages:
-        raise SystemExit(f"kage.ppo.train: {path} was started with other training stages ({previous.get('stages')} "
-                         f"then, {stages} now): restore the schedule or weights, or use another --out")
+        return (f"kage.ppo.train: {path} was started with other training stages ({previous.get('stages')} then, "
+                f"{stages} now): restore the schedule or weights, or use another --out")
     changed = changed_arguments(previous["args"], args)
     if changed:
         details = ", ".join(f"{k}: {before!r} then, {args[k]!r} now" for k, before in changed)
-        raise SystemExit(f"kage.ppo.train: {path} was started with other arguments ({details}); "
-                         "rerun with the original ones to resume, or use another --out")
+        return (f"kage.ppo.train: {path} was started with other arguments ({details}); rerun with the original ones "
+                "to resume, or use another --out")
+    return None
 
 
 class Progress:

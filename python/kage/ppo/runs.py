@@ -60,7 +60,9 @@ def open_batches(args: Args, threads: int) -> Run:
         except schedule.ScheduleError as e:
             raise SystemExit(f"kage.ppo.train: {e}") from None
         except ConfigError as e:  # kagec's located line names the key, both files and the rule
-            raise SystemExit(str(e)) from None
+            given = f"the stages of {args.train_schedule}" if args.train_schedule else "--train-config-paths"
+            raise SystemExit(f"{e}\nkage.ppo.train: {given}: train on configs of one hidden game, which differ only "
+                             "on visual axes (kagec diff --mixture FILE... shows every difference)") from None
     run = Run(args, specs, stages, {path: label for label, path in configs[:len(schedule.distinct_configs(stages))]},
               stream=streams.new_stream(args.device))
     run.env = stage_batch(run, 0, args.num_envs, "--num-envs", threads, seed=args.seed)

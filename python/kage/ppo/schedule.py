@@ -168,10 +168,18 @@ def _stage(path: str, base: str, i: int, node, stage) -> Stage:
                                 f"{base}, or a shipped config's name): fix the path") from None
     weights = stage.get("weights")
     if "weights" in stage:
+        weights_node = _child(node, "weights")
+        if weights is None:  # `weights:` with no value would read as equal weights
+            raise ScheduleError(f"{path}:{_line(weights_node)}: stages[{i}].weights: no value: a list of "
+                                f"{len(configs)} non-negative numbers, one per config, or leave the key out for "
+                                "equal weights")
         try:
             mixture.weights_of(weights, len(configs))
-        except ValueError as e:
-            raise ScheduleError(f"{path}:{_line(_child(node, 'weights'))}: stages[{i}].{e}") from None
+        except mixture.WeightsError as e:
+            at = weights_node
+            if e.index is not None and isinstance(weights_node, yaml.SequenceNode):
+                at = weights_node.value[e.index]
+            raise ScheduleError(f"{path}:{_line(at)}: stages[{i}].{e}") from None
         weights = tuple(float(w) for w in weights)
     return Stage(start, tuple(resolved), weights, _line(_child(node, "start")))
 
