@@ -152,3 +152,18 @@ def test_a_plug_in_drawing_from_a_global_generator_is_warned_of_before_any_run(t
     err = capsys.readouterr().err
     warning = "kage.bench: warning: --augment bad_plugins:global_numpy_flip draws from numpy's global random generator"
     assert warning in err and err.index(warning) < err.index("[1/")  # before the first run starts
+
+
+def test_a_run_that_fails_in_training_is_named_with_its_cause(tmp_path, capsys, monkeypatch):
+    """An augmentation that passes the check on blank frames and fails on real ones: the run's line gives the log's
+    last line (the trainer's one-line reason), and the summary says to fix it before rerunning."""
+    here = os.path.dirname(os.path.abspath(__file__))  # where the trainer's process imports bad_plugins from
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [here, os.environ.get("PYTHONPATH")])))
+    suite = write_suite(tmp_path)
+    status = run.main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *TINY_TRAINING,
+                       "--augment", "bad_plugins:raises_on_real_frames"])
+    err = capsys.readouterr().err
+    assert status == 1
+    assert "FAILED (exit 1): kage.ppo.train: --augment bad_plugins:raises_on_real_frames: on uint8 frames " in err
+    assert "it raised ValueError: not on real frames; see " in err
+    assert "kage.bench run: 1 run(s) failed: alone seed 1; fix what each log's last line says" in err

@@ -537,19 +537,21 @@ def train_jobs(bench: Bench, jobs: List[tasks.Job], pack_prefix: str, task: Unio
                       "their last checkpoints", file=sys.stderr, flush=True)
                 # The shell's convention for "ended by signal N", as the trainer's: Ctrl-C 130, SIGTERM 143.
                 return 128 + (signal.SIGINT if isinstance(stopped, KeyboardInterrupt) else signal.SIGTERM)
+        error = None
         if child.returncode == 0:
             run_state.mark(run_dirs, "done", task=task, log=log_path)
         else:
-            run_state.mark(run_dirs, "failed", task=task, log=log_path, exit_code=child.returncode,
-                           error=run_state.last_error(log_path))
+            error = run_state.last_error(log_path)
+            run_state.mark(run_dirs, "failed", task=task, log=log_path, exit_code=child.returncode, error=error)
         for one in labels:
             if child.returncode == 0:
                 display.finished(one, "done")
             else:
                 failures.append(one)
-                display.finished(one, f"FAILED (exit {child.returncode}); see {log_path}")
+                display.finished(one, f"FAILED (exit {child.returncode}): {error}; see {log_path}")
     if failures:
-        print(f"kage.bench run: {len(failures)} run(s) failed: {', '.join(failures)}; rerun to resume them",
+        print(f"kage.bench run: {len(failures)} run(s) failed: {', '.join(failures)}; fix what each log's last line "
+              "says (above; kage.bench status DIR keeps them) and rerun: they resume from their last checkpoints",
               file=sys.stderr)
         return 1
     return 0
