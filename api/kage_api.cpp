@@ -90,6 +90,10 @@ bool checked_host_actions(const Actions& a, int32_t n, std::vector<int32_t>* out
   return problem.empty() || fail(error, "kage: " + problem);
 }
 
+/// A state saved before the first reset would restore as a started batch of all-zero episodes.
+constexpr const char* kSaveBeforeReset =
+    "kage: save_state before reset: the batch holds no episode until its first reset (or load_state); reset it first";
+
 /// Before its first reset (or load_state) a batch holds no episode: a step, or a reset that leaves some
 /// environments out, would run an all-zero state. The reason to refuse, or empty.
 std::string unstarted_problem(bool started, bool stepping, const uint8_t* mask, int32_t n) {
@@ -201,7 +205,8 @@ class HostEnv final : public Env {
   }
   bool synchronize(std::string*) override { return true; }
   std::string pending_error() override { return {}; }
-  bool save_state(std::vector<uint8_t>* out, std::string*) const override {
+  bool save_state(std::vector<uint8_t>* out, std::string* e) const override {
+    if (!started_) return fail(e, kSaveBeforeReset);
     return *out = batch_.save_state(hash_), true;
   }
   bool load_state(const uint8_t* data, size_t size, std::string* e) override {
@@ -321,6 +326,7 @@ class GpuEnv final : public Env {
            "; that step ran with the value masked to its low 3 bits";
   }
   bool save_state(std::vector<uint8_t>* out, std::string* e) const override {
+    if (!started_) return fail(e, kSaveBeforeReset);
     return bind(e) && batch_.save_state(hash_, out, e);
   }
   bool load_state(const uint8_t* data, size_t size, std::string* e) override {

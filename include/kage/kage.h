@@ -164,7 +164,8 @@ class Env {
   ErrorKind last_error_kind() const { return last_error_kind_; }
 
   /// The whole batch's state and last outputs (about 1.4 KB per environment, not the observations),
-  /// readable by load_state on either backend. Waits for queued work.
+  /// readable by load_state on either backend. Waits for queued work. Refused before the first reset (or
+  /// load_state): the batch holds no episode yet.
   [[nodiscard]] virtual bool save_state(std::vector<uint8_t>* out, std::string* error = nullptr) const = 0;
   /// Restores a state saved from the same configuration and environment count, then renders its
   /// observations: the batch continues exactly as the one that was saved.

@@ -120,7 +120,9 @@ def config_list(configs) -> List[str]:
 def yaml_configs(paths: Sequence[str]) -> List[str]:
     """`paths` (resolved) when none is a kagec compile directory, which holds no config to certify: ValueError."""
     for p in paths:
-        if os.path.isdir(p):
+        if os.path.isdir(p) and os.path.isfile(os.path.join(p, "manifest.json")):
             raise ValueError(f"{p} is a kagec compile directory: a mixture is certified from its configs' YAML, so give "
                              "the YAML configs it was compiled from")
+        if os.path.isdir(p):
+            raise ValueError(f"{p} is a directory, not a YAML config: name the config file in it")
     return list(paths)

@@ -7,8 +7,7 @@ This view hides that: the step that ends an episode returns that episode's last 
 ``terminated`` or ``truncated`` true, as Gymnasium's API says. Then ``reset()`` without a seed returns the
 first observation of the episode the runtime already started in that step (its randomness comes from the
 environment's own seed stream, as in ``kage.make_vec``); ``reset(seed=s)`` starts afresh from ``s``.
-Stepping on after an episode's end without ``reset()`` continues that new episode (Gymnasium's
-PassiveEnvChecker warns about it).
+Stepping on after an episode's end without ``reset()`` continues that new episode.
 
 Seeds as Gymnasium's: ``reset()`` anywhere else (the first reset, or in the middle of an episode, as a
 ``TimeLimit`` wrapper's truncation leaves it) starts a new episode from a seed drawn from ``self.np_random``,
@@ -68,6 +67,7 @@ class SingleEnv(gymnasium.Env):
 
     def render(self) -> Optional[np.ndarray]:
         """The last observation returned, [H, W, 3] uint8 (render_mode "rgb_array"), or None."""
+        self._live()
         return None if self.render_mode is None or self._frame is None else self._frame.copy()
 
     def close(self) -> None:

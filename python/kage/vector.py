@@ -226,6 +226,10 @@ class VecEnv(spaces.VectorEnvBase):
     def __enter__(self) -> "VecEnv":
         return self
 
+    def __reduce_ex__(self, protocol):  # pickle, copy.copy and copy.deepcopy alike: a copy would share the batch
+        raise TypeError("a VecEnv holds the runtime's batch and cannot be pickled or copied: make another with "
+                        "kage.make_vec and carry the state over with save_state() and load_state()")
+
     def __exit__(self, *exc) -> None:
         self.close()
 
@@ -372,8 +376,8 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
     Raises ``kage.ConfigError`` (with kagec's located diagnostics) for a config with errors,
     ``FileNotFoundError`` for a missing config, ``RuntimeError`` for ``device="cuda"`` without a usable
     GPU, ``ValueError`` for bad arguments and for a CPU batch that would need more than half of the
-    machine's memory. The batch holds no episode until the first ``reset()`` (or ``load_state``): a step
-    before it raises ``RuntimeError``. Every argument is checked before anything is made. A YAML config's
+    machine's memory. The batch holds no episode until the first ``reset()`` (or ``load_state``): a step or a
+    ``save_state`` before it raises ``RuntimeError`` (``outputs()`` shows zeros). Every argument is checked before anything is made. A YAML config's
     warnings (``kagec lint``'s: an inert setting, a reproduced quirk, ...) and the asset loader's are given as
     one ``kage.ConfigWarning``.
     """
@@ -383,7 +387,7 @@ def make_vec(config: Union[str, os.PathLike, Sequence[Union[str, os.PathLike]]],
                         "directory, or a shipped config's name; or a list of YAML configs (a mixture)")
     if weights is not None and not mixture:
         raise ValueError("weights= splits a mixture: give a list of configs")
-    configs = _mixture.config_list(config) if mixture else [os.fspath(config)]
+    configs = _mixture.config_list(config) if mixture else [os.fsdecode(os.fspath(config))]
     if device not in ("cpu", "cuda"):
         raise ValueError(f"device={device!r}: use 'cpu' or 'cuda'")
     if not _is_integer(num_envs) or not 0 < num_envs <= MAX_INT32:

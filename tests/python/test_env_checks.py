@@ -1,5 +1,5 @@
 """The environment API refuses what it would otherwise coerce or misread: reset masks that are not booleans,
-seeds that are not non-negative integers, a step before any reset, sizes beyond the binding's integers or
+seeds that are not non-negative integers, a step or a saved state before any reset, sizes beyond the binding's integers or
 the machine's memory, and a config that is not UTF-8 (reported as kagec's located error, not a Python
 decoding error)."""
 import math
@@ -66,6 +66,15 @@ def test_step_before_reset_raises():
             env.reset(seed=1, options={"reset_mask": [True, False, True]})
         env.reset(seed=1)
         env.step(np.zeros(3, dtype=np.int64))
+
+
+def test_a_state_saved_before_the_first_reset_is_refused():
+    """It would restore as a started batch of all-zero episodes, which a step before reset is refused to run."""
+    with kage.make_vec(SIMPLEST, 2) as env:
+        with pytest.raises(RuntimeError, match=r"save_state before reset: .* reset it first"):
+            env.save_state()
+        env.reset(seed=0)
+        assert len(env.save_state()) > 0
 
 
 def test_a_loaded_state_counts_as_a_reset():

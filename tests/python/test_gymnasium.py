@@ -166,7 +166,7 @@ def test_a_closed_single_environment_names_how_to_make_another():
     env.reset(seed=0)
     env.close()
     env.close()  # twice is harmless
-    for call in (env.reset, lambda: env.step(0)):
+    for call in (env.reset, lambda: env.step(0), env.render):
         with pytest.raises(RuntimeError, match=r"closed: make a new one with gymnasium\.make\('kage/KAGE-v0', "):
             call()
 

@@ -207,8 +207,13 @@ def test_other_refusals_are_one_line_each(nothing_opened, tmp_path):
         kage.make_vec([NEAR_GOAL, 3], 2)
     refused(e)
     (tmp_path / "compiled").mkdir()
+    (tmp_path / "compiled" / "manifest.json").write_text("{}")  # what kagec compile writes there
     with pytest.raises(ValueError, match="is a kagec compile directory") as e:
         kage.make_vec([NEAR_GOAL, str(tmp_path / "compiled")], 2)
+    refused(e)
+    (tmp_path / "folder").mkdir()
+    with pytest.raises(ValueError, match="folder is a directory, not a YAML config: name the config file in it") as e:
+        kage.make_vec([NEAR_GOAL, str(tmp_path / "folder")], 2)
     refused(e)
 
 

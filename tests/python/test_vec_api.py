@@ -84,6 +84,21 @@ def test_context_manager_closes():
     env.close()  # a second close is harmless
 
 
+def test_a_batch_is_neither_pickled_nor_copied():
+    """A copy would share the runtime's batch (closing one closes both): the way across is save_state."""
+    import copy
+    import pickle
+    with kage.make_vec(SIMPLEST, 1) as env:
+        for attempt in (pickle.dumps, copy.copy, copy.deepcopy):
+            with pytest.raises(TypeError, match=r"cannot be pickled or copied: .*save_state\(\) and load_state\(\)"):
+                attempt(env)
+
+
+def test_a_bytes_path_is_read_as_a_path():
+    with kage.make_vec(SIMPLEST.encode(), 1) as env:
+        assert env.config == SIMPLEST and env.configs == (SIMPLEST,)
+
+
 def test_views_outlive_close():
     env = kage.make_vec(SIMPLEST, 2)
     obs, _ = env.reset(seed=0)
