@@ -464,6 +464,8 @@ def test_refuses_one_directory_and_alike_names(two, tmp_path):
         compare.compare([str(a), str(twin)], reps=100)
     with pytest.raises(SystemExit, match="--names gives 1 names for 2 directories"):
         compare.compare([str(a), str(b)], names=["x"], reps=100)
+    with pytest.raises(SystemExit, match="--names '' 'b': a method's name is the title of its columns"):
+        compare.compare([str(a), str(b)], names=["", "b"], reps=100)
 
 
 # ---- end to end on the CPU ----

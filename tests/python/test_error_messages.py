@@ -286,6 +286,16 @@ def test_scoring_flags_and_batches_that_cannot_be_made_end_in_a_message(tmp_path
 SUITE = "suite: names\npairs:\n  - name: alone\n    axis: background\n    train: {c}\n    eval: {c}\n"
 
 
+@pytest.mark.parametrize("flags, names", [
+    (["--suite", "kage_bench_typo"], ["--suite", "kage_bench_typo"]),  # before anything is made
+    (["--suite", "kage_bench", "--out", "/proc/no-such-dir"], ["/proc/no-such-dir", "--out"]),
+])
+def test_scoring_a_suite_that_is_not_there_or_an_out_that_cannot_be_written(tmp_path, finished, flags, names):
+    one_message(command("kage.bench", "score", str(finished), "--device", "cpu", "--episodes", "1",
+                        "--out", str(tmp_path / "scores"), *flags), *names)
+    assert not (tmp_path / "scores").exists()
+
+
 @pytest.mark.parametrize("command_name", ["run", "slurm"])
 def test_a_benchmark_out_that_is_a_file_ends_in_a_message(tmp_path, command_name):
     (tmp_path / "suite.yaml").write_text(SUITE.format(c=NOISY_SKELETON))

@@ -125,7 +125,9 @@ def test_a_killed_reports_temporary_files_are_removed_by_the_next_report(bench):
 
 
 @pytest.mark.parametrize("text, found", [("[]", "not an object"), ('{"seeds": ["1"]}', "'seeds'"),
-                                         ('{"units": [3], "seeds": [1]}', "'units'")], ids=["list", "seeds", "units"])
+                                         ('{"units": [3], "seeds": [1]}', "'units'"),
+                                         ('{"seeds": [1], "trainer_args": 5}', "'trainer_args'")],
+                         ids=["list", "seeds", "units", "trainer_args"])
 def test_a_damaged_bench_json_is_refused_by_name(tmp_path, text, found):
     (tmp_path / "suite.json").write_text(json.dumps(SUITE))
     (tmp_path / "bench.json").write_text(text)
@@ -133,6 +135,19 @@ def test_a_damaged_bench_json_is_refused_by_name(tmp_path, text, found):
         report.report(str(tmp_path))
     message = str(refused.value)
     assert str(tmp_path / "bench.json") in message and found in message and "fix or delete it" in message, message
+
+
+def test_without_bench_json_shared_runs_are_not_left_out_silently(tmp_path):
+    """Only bench.json's "shared" names the pairs of the runs in runs/shared/ (--share-training): without it (or with
+    a bench.json that lacks it) the report would leave them out of every table, so it is refused."""
+    (tmp_path / "suite.json").write_text(json.dumps(SUITE))
+    (tmp_path / "runs" / "shared").mkdir(parents=True)
+    for text in (None, '{"seeds": [1]}'):
+        if text is not None:
+            (tmp_path / "bench.json").write_text(text)
+        with pytest.raises(SystemExit, match=r"bench.json (not found|is damaged \(no 'shared'\)): restore it: its "
+                                             r"'shared' names the pairs of the runs in runs/shared/"):
+            report.report(str(tmp_path))
 
 
 def by_name(entries, key, name):

@@ -38,6 +38,7 @@ improvement.csv (P(X > Y) per axis and pair of methods), compare.json (everythin
 plots/profile_<metric>.png.
 """
 import argparse
+import contextlib
 import copy
 import dataclasses
 import difflib
@@ -100,21 +101,29 @@ def scored(run: report.Run, max_step: Optional[int]) -> bool:
                                      run.evaluations[-1]["global_step"] >= max_step)
 
 
-def load(bench_dir: str, name: str, protocol: str, max_step: Optional[int] = None) -> Method:
+@contextlib.contextmanager
+def in_compares_name():
+    """The report's refusals of a directory or a record, in compare's name."""
     try:
-        suite, bench, units, runs = report.read_benchmark(bench_dir)
-    except SystemExit as e:  # the report's refusal of a directory or a record, in compare's name
+        yield
+    except SystemExit as e:
         prefix = "kage.bench report: "
         if str(e).startswith(prefix):
             fail(str(e)[len(prefix):])
         raise
+
+
+def load(bench_dir: str, name: str, protocol: str, max_step: Optional[int] = None) -> Method:
+    with in_compares_name():
+        suite, bench, units, runs = report.read_benchmark(bench_dir)
     every_run = [r for unit_runs in runs.values() for r in unit_runs]
     schedules = {json.dumps(schedule_of(r), sort_keys=True) for r in every_run if r.args}
     if len(schedules) > 1:
         fail(f"the runs of {bench_dir} were trained with different schedules ({' and '.join(sorted(schedules))}): "
              "rerun them with one set of flags")
     seeds = bench.get("seeds") or sorted({r.seed for r in every_run})
-    levels = report.aggregate(units, runs, protocol, partial=max_step is not None, max_step=max_step)
+    with in_compares_name():
+        levels = report.aggregate(units, runs, protocol, partial=max_step is not None, max_step=max_step)
     counted = {r.path for r in every_run if scored(r, max_step)}
     levels["runs"] = [r for r in levels["runs"] if r["path"] in counted]
     if not levels["pairs"]:
@@ -458,6 +467,9 @@ def method_names(dirs: List[str], names: Optional[List[str]]) -> List[str]:
         chosen = names
     else:
         chosen = [os.path.basename(os.path.normpath(d)) for d in dirs]
+    if not all(name.strip() for name in chosen):
+        fail(f"--names {' '.join(repr(n) for n in chosen)}: a method's name is the title of its columns: give "
+             "each a non-empty name")
     if len(set(chosen)) < len(chosen):
         fail(f"two methods would be named alike ({', '.join(chosen)}): name them with --names")
     return chosen

@@ -130,14 +130,23 @@ def load_suite(bench_dir: str) -> dict:
 
 
 def read_bench(bench_dir: str) -> dict:
-    """bench.json, informational: {} where it is absent."""
+    """bench.json: {} where it is absent, unless runs were shared between pairs (--share-training), whose pairs
+    only its "shared" names."""
     path = os.path.join(bench_dir, "bench.json")
+    shared_runs = os.path.isdir(os.path.join(bench_dir, "runs", "shared"))
+    remedy = ("restore it: its 'shared' names the pairs of the runs in runs/shared/ (--share-training)" if shared_runs
+              else "fix or delete it (the report reads only its seeds, units and trainer flags)")
     if not os.path.exists(path):
+        if shared_runs:
+            fail(f"{path} not found: {remedy}")
         return {}
-    bench = read_json(path, "fix or delete it (the report reads only its seeds and units)")
-    problem = bench_problem(bench, [k for k in ("units", "seeds") if isinstance(bench, dict) and k in bench])
+    bench = read_json(path, remedy)
+    problem = bench_problem(bench, [k for k in ("units", "seeds", "trainer_args")
+                                    if isinstance(bench, dict) and k in bench])
+    if not problem and shared_runs and "shared" not in bench:
+        problem = "no 'shared'"
     if problem:
-        fail(f"{path} is damaged ({problem}): fix or delete it (the report reads only its seeds and units)")
+        fail(f"{path} is damaged ({problem}): {remedy}")
     return bench
 
 

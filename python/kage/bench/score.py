@@ -19,7 +19,7 @@ from kage.fields import SUCCESS_SHOWN
 from kage.ppo import rundir
 from kage.ppo.evaluate import add_scoring_arguments, fail, load_for_scoring, open_env, result_of, settings_of
 from kage.ppo.evaluation import EvalTargets, evaluation_rows
-from kage.util.files import output_folder, write_json
+from kage.util.files import os_error_text, output_folder, write_json
 
 PROTOCOL = ("One checkpoint, evaluated once on each side of each pair (the protocol of an evaluation point during "
             "training): a pair's values are that evaluation's (n = 1, SEM 0); per axis, the mean ± SEM of the "
@@ -31,7 +31,7 @@ def score_suite(agent, spec: dict, file: str, state: dict, options) -> dict:
     """Every chosen pair or sweep evaluated like a training run's evaluation point, then the report's three
     levels (kage.bench.report.aggregate) over these single evaluations."""
     try:
-        suite = front_end.suite_report(resources.suite_path(options.suite))
+        suite = front_end.suite_report(options.suite)
     except ConfigError as e:
         fail(f"{e}\nkage.bench score: fix the suite first")
     units = select(units_of(suite), options.pairs, "kage.bench score")
@@ -62,8 +62,15 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser.add_argument("--pairs", nargs="+", help="only these pairs or sweeps")
     parser.add_argument("--out", required=True, help="where to write the tables (created)")
     options = parser.parse_args(argv)
+    try:
+        options.suite = resources.suite_path(options.suite)
+    except FileNotFoundError as e:  # names the shipped suites nearest to it
+        fail(f"--suite: {e}")
     file, agent, spec, state = load_for_scoring(parser, options)
-    output_folder(options.out)
+    try:
+        output_folder(options.out)
+    except OSError as e:  # a file there, a read-only or full file system
+        raise SystemExit(os_error_text("kage.bench score", e, "--out")) from None
     header = f"checkpoint {file} (iteration {state['iteration']}, seed {options.seed})"
     result = dict(result_of(file, spec, state, options), **score_suite(agent, spec, file, state, options))
     files = tables.write_tables(options.out, f"{result['suite']}: {header}", result["levels"], result["status"],

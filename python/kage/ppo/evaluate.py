@@ -188,7 +188,7 @@ def add_scoring_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--num-envs", type=int, default=32, help="parallel environments per config (default 32)")
     parser.add_argument("--seed", type=int, help="evaluation seed (default: the run's)")
     parser.add_argument("--greedy", action="store_true", help="most likely actions (QUIRK off: sampled, §3.2)")
-    parser.add_argument("--device", default="cuda", help="cuda or cpu")
+    parser.add_argument("--device", default="cuda", help="cuda or cpu (default: cuda)")
     parser.add_argument("--threads", type=int, help="CPU threads (default: all cores)")
     parser.add_argument("--asset-root", help="resolve the configs' asset paths here")
     parser.add_argument("--agent", help="module:factory of the checkpoint's network when it is not the baseline's "
