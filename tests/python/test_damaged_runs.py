@@ -1,7 +1,8 @@
 """Damaged run data is refused by name, never read as something else: duplicated or out-of-order evaluation rows
 (which --protocol final would misread as the last evaluation), a bench.json whose seeds kage.bench run would not
 train or whose units leave DIR/runs/ (which status and report would count differently), an evaluation row whose
-sides are not objects of numbers, one seed in two folders, and records of the wrong shape. Each refusal is one
+sides are not objects of numbers, one seed in two folders, records of the wrong shape, and a summary.json whose
+values or last evaluation its run could not have written beside its log. Each refusal is one
 SystemExit line naming the file and the fix; the values expected are worked out here."""
 import io
 import json
@@ -128,3 +129,36 @@ def test_a_run_json_without_an_args_object_is_refused(tmp_path):
     run, = bench_dir(tmp_path, [eval_row(0, 0.5, {"eval": 0.5})])
     (run / "run.json").write_text(json.dumps({"kage_run": 1, "args": []}))
     refusal(lambda: report.report(str(tmp_path), reps=100), str(run / "run.json"), "not a kage.ppo.train run record")
+
+
+# ---- a finished run's summary.json against its log ----
+
+def test_final_protocol_refuses_a_log_that_lost_its_last_rows(tmp_path):
+    """summary.json counts the evaluation of step 100; a log cut after step 0's (a copy cut short) was read as
+    ending there, and --protocol final scored step 0's values as the final checkpoint's."""
+    run, = bench_dir(tmp_path, [eval_row(0, 1.0, {"eval": 1.0}), eval_row(100, 0.0, {"eval": 0.0})])
+    lines = (run / "metrics.jsonl").read_text().splitlines(keepends=True)
+    (run / "metrics.jsonl").write_text("".join(lines[:-1]))
+    refusal(lambda: report.report(str(tmp_path), protocol="final", reps=100), str(run / "metrics.jsonl"),
+            "ends at the evaluation of step 0, before the last that summary.json counts (step 100)", "restore it")
+    report.report(str(tmp_path), reps=100)  # the paper's protocol reads summary.json alone
+
+
+@pytest.mark.parametrize("value, said", [(1e300, "max 1e+300, outside [0, 1]"), (-7, "max -7, outside [0, 1]")])
+def test_a_share_of_episodes_outside_0_1_is_refused(tmp_path, value, said):
+    run, = bench_dir(tmp_path, [eval_row(0, 0.5, {"eval": 0.5})])
+    record = json.loads((run / "summary.json").read_text())
+    record["stats"]["eval/eval/success_once"]["max"] = value
+    (run / "summary.json").write_text(json.dumps(record))
+    refusal(lambda: report.report(str(tmp_path), reps=100), str(run / "summary.json"), "eval/eval/success_once", said)
+
+
+def test_one_side_without_a_value_is_refused(tmp_path):
+    """A null eval value left the train side's mean over five seeds and the eval side's over four: a gap of
+    different runs."""
+    run, = bench_dir(tmp_path, [eval_row(0, 0.5, {"eval": 0.5})])
+    record = json.loads((run / "summary.json").read_text())
+    record["stats"]["eval/eval/success_once"] = None
+    (run / "summary.json").write_text(json.dumps(record))
+    refusal(lambda: report.report(str(tmp_path), reps=100), "eval/eval/success_once has no value where the other "
+            "side has one")

@@ -68,7 +68,11 @@ def write_run(bench, unit, seed, labels, maxima=None, rows=(), tail=""):
     lines = [json.dumps(train_row)] + [json.dumps(r) for r in rows]
     (run / "metrics.jsonl").write_text("\n".join(lines) + "\n" + tail)
     if maxima is not None:
-        (run / "summary.json").write_text(json.dumps(summary(labels, maxima)))
+        record = summary(labels, maxima)
+        steps = [r["global_step"] for r in rows if r.get("kind") == "eval"]
+        if steps:  # the evaluations the log holds, as the trainer's summary counts them
+            record.update(evaluations=len(steps), global_steps=steps)
+        (run / "summary.json").write_text(json.dumps(record))
     return run
 
 

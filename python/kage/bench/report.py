@@ -94,6 +94,7 @@ class Run:
     stats: Optional[dict]  # summary.json's stats; None while the run is unfinished
     evaluations: List[dict]  # the evaluation rows of metrics.jsonl
     args: dict = field(default_factory=dict)  # run.json's: the trainer's arguments
+    last_step: Optional[int] = None  # summary.json's last evaluation's global step, where it records one
 
 
 def read_json(path: str, remedy: str):
@@ -172,22 +173,27 @@ def read_run(seed: int, path: str) -> Run:
     summary = os.path.join(path, "summary.json")
     metrics = os.path.join(path, "metrics.jsonl")
     run_json = os.path.join(path, "run.json")
-    stats = read_summary(summary) if os.path.exists(summary) else None
+    stats, last_step = read_summary(summary) if os.path.exists(summary) else (None, None)
     evaluations = read_evaluations(metrics) if os.path.exists(metrics) else []
     remedy = "delete the run directory and rerun `python3 -m kage.bench run` to train it again"
     record = read_json(run_json, remedy) if os.path.exists(run_json) else {"args": {}}
     args = record.get("args") if isinstance(record, dict) else None
     if not isinstance(args, dict):
         fail(f"{run_json} is not a kage.ppo.train run record ({{\"args\": {{...}}}}): {remedy}")
-    return Run(seed, path, stats, evaluations, args)
+    return Run(seed, path, stats, evaluations, args, last_step)
 
 
 def is_number(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
-def read_summary(path: str) -> dict:
-    """summary.json's stats: {key: {"max": ..., ...} or null}."""
+# Values that are shares of episodes, on either side: a summary outside [0, 1] is not a run's.
+SHARES = ("success", "success_once")
+
+
+def read_summary(path: str) -> Tuple[dict, Optional[int]]:
+    """summary.json's stats ({key: {"max": ..., ...} or null}) and its last evaluation's global step (None where
+    it records none)."""
     remedy = "delete it and rerun `python3 -m kage.bench run` on the directory to write it again from the run's " \
              "last checkpoint"
     summary = read_json(path, remedy)
@@ -196,7 +202,13 @@ def read_summary(path: str) -> dict:
             and all(v is None or (isinstance(v, dict) and is_number(v.get("max"))) for v in stats.values())):
         fail(f"{path} is not a kage.ppo.train summary ({{\"kage_summary\": 1, \"stats\": {{key: {{\"max\": number, ...}} "
              f"or null}}}}): {remedy}")
-    return stats
+    for key, value in stats.items():
+        side, _, metric = key.rpartition("/")
+        if value is not None and metric in SHARES and not side.startswith("diff") and not 0 <= value["max"] <= 1:
+            fail(f"{path}: {key} has max {value['max']}, outside [0, 1] (a share of episodes): {remedy}")
+    steps = summary.get("global_steps")
+    last = steps[-1] if isinstance(steps, list) and steps and is_number(steps[-1]) else None
+    return stats, last
 
 
 MAX_LINE = 64 << 20  # bytes of one log row: a real one is a few KB
@@ -336,6 +348,10 @@ def run_values(run: Run, protocol: str, partial: bool = False,
     if not rows:
         fail(f"{os.path.join(run.path, 'metrics.jsonl')} has no evaluation row, which --protocol final reads: use "
              "--protocol max, or delete the run directory and rerun `python3 -m kage.bench run`")
+    if max_step is None and run.last_step is not None and rows[-1]["global_step"] < run.last_step:
+        fail(f"{os.path.join(run.path, 'metrics.jsonl')} ends at the evaluation of step {rows[-1]['global_step']}, "
+             f"before the last that summary.json counts (step {run.last_step}): the log lost its last rows, which "
+             "--protocol final reads: restore it, or use --protocol max (summary.json alone)")
     return flat_row(rows[-1])
 
 
@@ -353,6 +369,11 @@ def run_scores(values: dict, label: str, where: str = "summary.json") -> Dict[st
     for m in REPORT_METRICS:
         train = value_of(values, f"train/{m}", where)
         evaluated = value_of(values, f"eval/{label}/{m}", where)
+        if (train is None) != (evaluated is None):  # the pair's means would be over different seeds
+            empty = f"train/{m}" if train is None else f"eval/{label}/{m}"
+            fail(f"{where}: {empty} has no value where the other side has one, so the pair's gap would compare "
+                 "different runs: the file is damaged; restore it, or delete the run directory and rerun "
+                 "`python3 -m kage.bench run`")
         gap, drop = gap_and_drop(train, evaluated)
         diff = value_of(values, f"diff/{label}/{m}", where) if m in DIFF_METRICS else None
         scores[m] = {"train": train, "eval": evaluated, "gap": gap, "drop_pct": drop, "max_abs_diff": diff}
