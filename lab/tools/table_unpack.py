@@ -79,6 +79,8 @@ TASK_ARCHIVE = re.compile(r"task_(\d+)\.tar\.gz")  # pack_task.py's name for tas
 
 def unpack_all(packs: str, dest: str, say=print) -> int:
     """Unpacks every task_I.tar.gz of `packs` into `dest`, in task order, each checked; the number of tasks."""
+    if not os.path.isdir(packs):
+        sys.exit(f"table_unpack: {packs}: not a directory: give the packs folder (results/.../packs)")
     names = [n for n in os.listdir(packs) if n.endswith(".tar.gz")]
     for name in names:
         if not TASK_ARCHIVE.fullmatch(name):

@@ -155,6 +155,23 @@ def test_a_damaged_bench_state_does_not_abort_status(tmp_path):
         assert "bench_state.json" in line and "rewritten" in line, line
 
 
+def test_status_trusts_no_heartbeat_from_the_future_and_names_an_unknown_state(tmp_path):
+    """A heartbeat 30 days ahead (another host's clock) read as fresh for ever: "running" indefinitely."""
+    bench = tmp_path / "bench"
+    runs = {"ahead": {"state": "running", "time": time.time() + 30 * 86400, "host": "elsewhere"},
+            "odd": {"state": "exploded", "time": time.time(), "host": "elsewhere"}}
+    for unit, content in runs.items():
+        (bench / "runs" / unit / "seed_1").mkdir(parents=True)
+        (bench / "runs" / unit / "seed_1" / "bench_state.json").write_text(json.dumps(content))
+    (bench / "bench.json").write_text(json.dumps({"units": list(runs), "seeds": [1]}))
+    out = io.StringIO()
+    found = status.status(str(bench), out)
+    assert found["interrupted"] == ["ahead seed 1", "odd seed 1"] and not found.get("running")
+    text = out.getvalue()
+    assert "min in the future (another host's clock?)" in text and "state 'exploded', not one kage.bench run " \
+        "writes" in text, text
+
+
 def test_status_calls_a_fresh_running_run_interrupted_when_its_runner_here_is_gone(tmp_path):
     bench = tmp_path / "bench"
     here = socket.gethostname()

@@ -49,6 +49,9 @@ def classify(path: str, now: float) -> tuple:
         (f", GPU {state['gpu']}" if state.get("gpu") else "") + \
         (f", Slurm job {state['slurm_job']}" if state.get("slurm_job") else "")
     age = now - state["time"]
+    if age < -run_state.STALE_S:  # written by a host whose clock runs ahead (or damaged): no heartbeat to trust
+        return "interrupted", (f"its state was written {-age / 60:,.0f} min in the future (another host's clock?); "
+                               f"{at}; {where}")
     if state["state"] == "running" and age <= run_state.STALE_S:
         pid = state.get("pid")
         if state["host"] == socket.gethostname() and isinstance(pid, int) and not process_alive(pid):
@@ -61,6 +64,8 @@ def classify(path: str, now: float) -> tuple:
         return "interrupted", f"no heartbeat for {age / 60:,.0f} min (killed?); {at}; {where}"
     if state["state"] == "stopped":
         return "interrupted", f"stopped {age / 60:,.0f} min ago; {at}; {where}"
+    if state["state"] != "done":
+        return "interrupted", f"state {state['state']!r}, not one kage.bench run writes; {at}; {where}"
     return "interrupted", f"{at}; {where}"  # "done" without summary.json: ended early
 
 
