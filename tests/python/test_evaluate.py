@@ -83,10 +83,11 @@ def score(*args):
 
 def test_augmentation_only_on_update_minibatches(run):
     out, around = run
-    # The check on blank frames before anything is written (2 frames, then 2 read at indices); then 2 iterations
-    # x 1 epoch x 2 minibatches of 32 frames (drac, the default mode); 3 evaluations (iterations 0, 1, 2), and
-    # videos of both configs at iterations 0 and 2, none of which calls it.
-    assert counting_augment.calls == [2, 2] + [32] * 4
+    # The check on blank frames before anything is written (2 frames, then 3 read at indices: one more than it
+    # stores, so that a function that ignores the indices returns the wrong shape); then 2 iterations x 1 epoch x
+    # 2 minibatches of 32 frames (drac, the default mode); 3 evaluations (iterations 0, 1, 2), and videos of both
+    # configs at iterations 0 and 2, none of which calls it.
+    assert counting_augment.calls == [2, 3] + [32] * 4
     assert [name for name, _, _ in around].count("evaluation_rows") == 3
     assert [name for name, _, _ in around].count("record_frames") == 4
     assert all(before == after for _, before, after in around), around
