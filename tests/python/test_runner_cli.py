@@ -77,8 +77,8 @@ def test_a_schedule_stage_after_the_runs_end_is_refused_before_any_run(tmp_path)
                      f"    eval: {NOISY_SKELETON}\n")
     with pytest.raises(SystemExit) as caught:
         run.main([str(suite), "--seeds", "1", "--out", str(tmp_path / "bench"), *TINY_TRAINING])
-    assert caught.value.code == (f"kage.bench: late (trains on {schedule}): a stage starts at iteration 50, but the "
-                                 "run has 1 iterations: start it earlier, or raise --total-timesteps")
+    assert caught.value.code == (f"kage.bench: late: {schedule}:3: stages[1].start 50, but the run has 1 iterations: "
+                                 "start it earlier, or raise --total-timesteps")
     assert not (tmp_path / "bench").exists()
 
 

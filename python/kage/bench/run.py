@@ -384,8 +384,14 @@ def check_before_runs(probe, units) -> None:
     for unit in units:
         stages = [schedule.Stage(s["start"], tuple(c["name"] for c in s["configs"]))
                   for s in unit.training.get("stages", [])]
+        where = f"{unit.name} (trains on {unit.train})"
+        if unit.training.get("schedule"):  # the file itself, for the stage's line
+            try:
+                stages, where = schedule.read_schedule(unit.training["schedule"]), f"{unit.name}: {unit.train}"
+            except schedule.ScheduleError:  # changed since the suite was certified: each run's trainer says so
+                pass
         try:
-            schedule.check_iterations(stages, probe.num_iterations, f"{unit.name} (trains on {unit.train})")
+            schedule.check_iterations(stages, probe.num_iterations, where)
         except schedule.ScheduleError as e:
             raise SystemExit(f"kage.bench: {e}") from None
     if probe.agent == plugins.BASELINE_AGENT and not probe.augment:
