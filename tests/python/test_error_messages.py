@@ -136,20 +136,25 @@ def test_a_run_json_that_is_not_a_run_description(tmp_path, finished, text):
     one_message(command("kage.ppo.train", *FLAGS, "--out", str(run)), "run.json")
 
 
-def test_a_damaged_bench_state_does_not_abort_status(tmp_path):
-    bench = tmp_path / "bench"
-    runs = {"good": {"state": "failed", "time": 0, "host": "h", "exit_code": 1, "log": "x.log", "error": "boom"},
-            "list": [], "syntax": "{", "no_time": {"state": "running", "host": "h"},
-            "text_time": {"state": "running", "time": "yesterday", "host": "h"}, "no_host": {"state": "stopped", "time": 0}}
+def status_of(bench, runs):
+    """kage.bench status of a benchmark whose unit U's seed 1 has the bench_state.json runs[U] (text as it is, else
+    its JSON): the runs by category, and what it printed."""
     for unit, content in runs.items():
         (bench / "runs" / unit / "seed_1").mkdir(parents=True)
         state = bench / "runs" / unit / "seed_1" / "bench_state.json"
         state.write_text(content if isinstance(content, str) else json.dumps(content))
     (bench / "bench.json").write_text(json.dumps({"units": list(runs), "seeds": [1]}))
     out = io.StringIO()
-    found = status.status(str(bench), out)
+    return status.status(str(bench), out), out.getvalue()
+
+
+def test_a_damaged_bench_state_does_not_abort_status(tmp_path):
+    bench = tmp_path / "bench"
+    runs = {"good": {"state": "failed", "time": 0, "host": "h", "exit_code": 1, "log": "x.log", "error": "boom"},
+            "list": [], "syntax": "{", "no_time": {"state": "running", "host": "h"},
+            "text_time": {"state": "running", "time": "yesterday", "host": "h"}, "no_host": {"state": "stopped", "time": 0}}
+    found, text = status_of(bench, runs)
     assert found["failed"] == ["good seed 1"]
-    text = out.getvalue()
     for unit in ("list", "syntax", "no_time", "text_time", "no_host"):
         line = next(line for line in text.splitlines() if f"{unit} seed 1" in line)
         assert "bench_state.json" in line and "rewritten" in line, line
@@ -160,14 +165,8 @@ def test_status_trusts_no_heartbeat_from_the_future_and_names_an_unknown_state(t
     bench = tmp_path / "bench"
     runs = {"ahead": {"state": "running", "time": time.time() + 30 * 86400, "host": "elsewhere"},
             "odd": {"state": "exploded", "time": time.time(), "host": "elsewhere"}}
-    for unit, content in runs.items():
-        (bench / "runs" / unit / "seed_1").mkdir(parents=True)
-        (bench / "runs" / unit / "seed_1" / "bench_state.json").write_text(json.dumps(content))
-    (bench / "bench.json").write_text(json.dumps({"units": list(runs), "seeds": [1]}))
-    out = io.StringIO()
-    found = status.status(str(bench), out)
+    found, text = status_of(bench, runs)
     assert found["interrupted"] == ["ahead seed 1", "odd seed 1"] and not found.get("running")
-    text = out.getvalue()
     assert "min in the future (another host's clock?)" in text and "state 'exploded', not one kage.bench run " \
         "writes" in text, text
 
@@ -178,15 +177,10 @@ def test_status_calls_a_fresh_running_run_interrupted_when_its_runner_here_is_go
     runs = {"alive": {"state": "running", "time": time.time(), "host": here, "pid": os.getpid()},
             "killed": {"state": "running", "time": time.time(), "host": here, "pid": dead_pid()},
             "elsewhere": {"state": "running", "time": time.time(), "host": here + "-other", "pid": dead_pid()}}
-    for unit, content in runs.items():
-        (bench / "runs" / unit / "seed_1").mkdir(parents=True)
-        (bench / "runs" / unit / "seed_1" / "bench_state.json").write_text(json.dumps(content))
-    (bench / "bench.json").write_text(json.dumps({"units": list(runs), "seeds": [1]}))
-    out = io.StringIO()
-    found = status.status(str(bench), out)
+    found, text = status_of(bench, runs)
     assert found["running"] == ["alive seed 1", "elsewhere seed 1"]  # another host's process cannot be looked at
     assert found["interrupted"] == ["killed seed 1"]
-    line = next(line for line in out.getvalue().splitlines() if "killed seed 1" in line)
+    line = next(line for line in text.splitlines() if "killed seed 1" in line)
     assert f"its runner (pid {runs['killed']['pid']}, this host) is gone (killed?)" in line, line
 
 

@@ -65,7 +65,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     try:
         options.suite = resources.suite_path(options.suite)
     except FileNotFoundError as e:  # names the shipped suites nearest to it
-        fail(f"--suite: {e}")
+        raise SystemExit(f"kage.bench score: --suite: {e}") from None
     file, agent, spec, state = load_for_scoring(parser, options)
     try:
         output_folder(options.out)
